@@ -1,0 +1,59 @@
+//! `odocal`: simultaneous calibration of a differential-drive robot's odometry
+//! (wheel radii, wheel distance) and of its range finder's pose, from a raw log.
+//!
+//! This binary is thin: each subcommand lives in its own module and calls the
+//! library crates (`odocal-log`, `odocal-icp`, `odocal-solver`, `odocal-sim`,
+//! `odocal-pipeline`).
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+mod calibrate;
+mod info;
+mod matching;
+mod simulate;
+mod solve;
+mod table_i;
+
+/// Calibrate a differential-drive robot and its laser from nothing but a log.
+#[derive(Parser, Debug)]
+#[command(name = "odocal", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Raw log in, calibrated robot out: r_L, r_R, b and the laser pose, with uncertainty.
+    Calibrate(calibrate::Args),
+    /// Scan matching and synchronization only: write the samples (tuples).
+    Match(matching::Args),
+    /// Solve for the parameters from samples (tuple files).
+    Solve(solve::Args),
+    /// Describe a log: counts per message, time span, scan geometry, encoder rate.
+    Info(info::Args),
+    /// Simulate a robot with encoders and a URG-04LX; write a log and its ground truth.
+    Simulate(simulate::Args),
+    /// Reproduce the ICRA 2008 Table I in simulation and compare with the published rows.
+    TableI(table_i::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Calibrate(a) => calibrate::run(a),
+        Command::Match(a) => matching::run(a),
+        Command::Solve(a) => solve::run(a),
+        Command::Info(a) => info::run(a),
+        Command::Simulate(a) => simulate::run(a),
+        Command::TableI(a) => table_i::run(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,17 @@
+//! Reading and writing robot logs for odometry/laser calibration.
+//!
+//! The main format is the Carmen-style text log with wheel encoder ticks described in
+//! `docs/log-format.md` (PARAM, ENCODER, RAWLASER1, ROBOTLASER1, FLASER, ODOM). The
+//! reader streams the file line by line, stores ranges as `f32` and keeps one angle
+//! table per distinct scan geometry, so memory is about the size of the ranges.
+//!
+//! Also read: the original calibration package's raw JSON logs and its tuple files
+//! (streams of JSON objects, several of which may share a line).
+//!
+//! Data flows one way: text → [`Log`] (encoder records, scans, parameters, statistics).
+
+#![deny(missing_docs)]
+
+mod model;
+
+pub use model::*;
