@@ -12,6 +12,11 @@
 
 #![deny(missing_docs)]
 
+mod error;
+mod json_stream;
 mod model;
+mod tuple;
 
+pub use error::{LogError, MissingData};
 pub use model::*;
+pub use tuple::{read_tuples, read_tuples_from, write_tuple, TupleRecord};

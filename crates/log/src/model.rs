@@ -252,7 +252,14 @@ impl ScanStore {
     /// Appends a scan, reusing an equal geometry when one is stored already.
     ///
     /// `ranges.len()` must equal `geometry.num_readings()`.
-    pub fn push(&mut self, t: f64, geometry: &ScanGeometry, ranges: &[f32], kind: ScanKind, line: u64) {
+    pub fn push(
+        &mut self,
+        t: f64,
+        geometry: &ScanGeometry,
+        ranges: &[f32],
+        kind: ScanKind,
+        line: u64,
+    ) {
         debug_assert_eq!(ranges.len(), geometry.num_readings());
         let gi = match self.geometries.iter().position(|g| g == geometry) {
             Some(i) => i,
