@@ -1,0 +1,502 @@
+//! Synchronization of the encoder stream with the scan stream.
+//!
+//! A sample needs, for a pair of scans taken at `t0` and `t1` (laser clock), the wheel
+//! rotations over `[t0 + δ, t1 + δ]` on the encoder clock (δ = the clock offset, 0
+//! unless estimated). Cumulative ticks are interpolated linearly between the two
+//! encoder records around each instant; the encoder *profile* inside the interval —
+//! the pieces between consecutive encoder records, clipped to the interval — is kept
+//! for the non-constant-speed formulas.
+
+use odocal_log::EncoderRecord;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Why a scan pair did not become a sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DiscardReason {
+    /// Both wheels turned less than the stillness threshold over the interval.
+    RobotStill,
+    /// No encoder record close enough around a scan timestamp (or inside the
+    /// interval), or the instant lies outside the encoder stream.
+    EncoderGap,
+    /// The scan matcher failed (no convergence, too few correspondences, …).
+    MatchFailed,
+    /// The two scans are further apart in time than allowed (dropped scans).
+    IntervalTooLong,
+}
+
+impl DiscardReason {
+    /// Every reason, in report order.
+    pub const ALL: [DiscardReason; 4] = [
+        DiscardReason::RobotStill,
+        DiscardReason::EncoderGap,
+        DiscardReason::MatchFailed,
+        DiscardReason::IntervalTooLong,
+    ];
+
+    /// The snake_case key used in reports and JSON.
+    pub fn key(self) -> &'static str {
+        match self {
+            DiscardReason::RobotStill => "robot_still",
+            DiscardReason::EncoderGap => "encoder_gap",
+            DiscardReason::MatchFailed => "match_failed",
+            DiscardReason::IntervalTooLong => "interval_too_long",
+        }
+    }
+}
+
+/// How many scan pairs were discarded, per reason (every reason present, possibly 0).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[serde(transparent)]
+pub struct DiscardCounts(pub BTreeMap<&'static str, usize>);
+
+impl Default for DiscardCounts {
+    fn default() -> Self {
+        DiscardCounts(DiscardReason::ALL.iter().map(|r| (r.key(), 0)).collect())
+    }
+}
+
+impl DiscardCounts {
+    /// Counts one more discarded pair.
+    pub fn add(&mut self, reason: DiscardReason) {
+        *self.0.entry(reason.key()).or_insert(0) += 1;
+    }
+
+    /// The count for one reason.
+    pub fn get(&self, reason: DiscardReason) -> usize {
+        self.0.get(reason.key()).copied().unwrap_or(0)
+    }
+
+    /// Total over all reasons.
+    pub fn total(&self) -> usize {
+        self.0.values().sum()
+    }
+}
+
+/// Two scans that form a candidate sample: indices into the scan store and their
+/// timestamps (laser clock, s).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScanPair {
+    /// Index of the first (reference) scan.
+    pub first: usize,
+    /// Index of the second (current) scan.
+    pub second: usize,
+    /// Timestamp of the first scan (laser clock).
+    pub t0: f64,
+    /// Timestamp of the second scan (laser clock).
+    pub t1: f64,
+}
+
+/// The wanted time between the two scans of a pair (s): long enough that one
+/// encoder tick is a small relative error, short enough that scans overlap well.
+pub const TARGET_INTERVAL_S: f64 = 0.4;
+
+/// Median of the positive differences between consecutive values (s), `None` when
+/// there are fewer than two values or no positive difference.
+pub fn median_period(times: &[f64]) -> Option<f64> {
+    let mut d: Vec<f64> = times
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .filter(|d| *d > 0.0 && d.is_finite())
+        .collect();
+    if d.is_empty() {
+        return None;
+    }
+    let mid = d.len() / 2;
+    let (_, m, _) = d.select_nth_unstable_by(mid, f64::total_cmp);
+    Some(*m)
+}
+
+/// The default stride: the number of scan periods closest to [`TARGET_INTERVAL_S`]
+/// (at least 1), so that intervals fall within about 0.3–0.5 s whatever the scan rate.
+pub fn default_stride(scan_times: &[f64]) -> usize {
+    match median_period(scan_times) {
+        Some(p) => ((TARGET_INTERVAL_S / p).round() as usize).max(1),
+        None => 1,
+    }
+}
+
+/// Pairs of scans `stride` apart, not overlapping: (0, k), (k, 2k), … so that every
+/// scan used serves at most twice and consecutive samples chain into a trajectory.
+pub fn scan_pairs(scan_times: &[f64], stride: usize) -> Vec<ScanPair> {
+    let k = stride.max(1);
+    let mut pairs = Vec::with_capacity(scan_times.len() / k);
+    let mut i = 0;
+    while i + k < scan_times.len() {
+        pairs.push(ScanPair {
+            first: i,
+            second: i + k,
+            t0: scan_times[i],
+            t1: scan_times[i + k],
+        });
+        i += k;
+    }
+    pairs
+}
+
+/// One piece of the encoder profile: a duration and the wheel rotations over it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ProfilePiece {
+    /// Duration (s).
+    pub dt: f64,
+    /// Left wheel rotation over the piece (rad).
+    pub dphi_l: f64,
+    /// Right wheel rotation over the piece (rad).
+    pub dphi_r: f64,
+}
+
+/// The wheel half of a sample: what the encoders say about one interval.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WheelMotion {
+    /// Interval start on the encoder clock (s).
+    pub t0: f64,
+    /// Interval length (s).
+    pub dt: f64,
+    /// Left wheel rotation (rad).
+    pub dphi_l: f64,
+    /// Right wheel rotation (rad).
+    pub dphi_r: f64,
+    /// The profile inside the interval; the pieces sum to `dt`, `dphi_l`, `dphi_r`.
+    pub profile: Vec<ProfilePiece>,
+}
+
+/// Thresholds of the synchronization.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SyncLimits {
+    /// Largest allowed time between the encoder records around an instant, and between
+    /// consecutive records inside an interval (s).
+    pub max_encoder_gap: f64,
+    /// A pair is "still" when both wheels turned less than this many ticks.
+    pub still_ticks: f64,
+    /// Longest allowed interval between the two scans of a pair (s).
+    pub max_interval: f64,
+}
+
+impl SyncLimits {
+    /// Defaults derived from the streams: encoder gaps up to 5 median encoder periods
+    /// (at least 50 ms), stillness below one tick on both wheels, intervals up to 1.5×
+    /// the nominal `stride` scan periods.
+    pub fn from_streams(encoder_times: &[f64], scan_times: &[f64], stride: usize) -> Self {
+        let enc_period = median_period(encoder_times).unwrap_or(0.01);
+        let scan_period = median_period(scan_times).unwrap_or(0.1);
+        SyncLimits {
+            max_encoder_gap: (5.0 * enc_period).max(0.05),
+            still_ticks: 1.0,
+            max_interval: 1.5 * stride.max(1) as f64 * scan_period,
+        }
+    }
+}
+
+/// The encoder stream, ready for interpolation.
+#[derive(Debug, Clone, Copy)]
+pub struct EncoderTrack<'a> {
+    records: &'a [EncoderRecord],
+    rad_per_tick: f64,
+}
+
+impl<'a> EncoderTrack<'a> {
+    /// A track over records sorted by time, with the wheel's ticks per revolution.
+    pub fn new(records: &'a [EncoderRecord], ticks_per_revolution: f64) -> Self {
+        EncoderTrack {
+            records,
+            rad_per_tick: std::f64::consts::TAU / ticks_per_revolution,
+        }
+    }
+
+    /// Radians of wheel rotation per tick.
+    pub fn rad_per_tick(&self) -> f64 {
+        self.rad_per_tick
+    }
+
+    /// Index `i` of the records bracketing `t`: `records[i-1].t ≤ t < records[i].t`
+    /// (or `t` equal to the last record's time, bracketed by the last two).
+    fn bracket(&self, t: f64, max_gap: f64) -> Result<usize, DiscardReason> {
+        let n = self.records.len();
+        if n < 2 || !t.is_finite() {
+            return Err(DiscardReason::EncoderGap);
+        }
+        let mut i = self.records.partition_point(|r| r.t <= t);
+        if i == n && self.records[n - 1].t == t {
+            i = n - 1;
+        }
+        if i == 0 || i == n {
+            return Err(DiscardReason::EncoderGap);
+        }
+        if self.records[i].t - self.records[i - 1].t > max_gap {
+            return Err(DiscardReason::EncoderGap);
+        }
+        Ok(i)
+    }
+
+    /// Cumulative ticks (left, right), linearly interpolated between records `i-1`, `i`.
+    fn ticks_between(&self, i: usize, t: f64) -> (f64, f64) {
+        let a = &self.records[i - 1];
+        let b = &self.records[i];
+        let span = b.t - a.t;
+        let u = if span > 0.0 {
+            ((t - a.t) / span).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let l = a.left as f64 + u * (b.left - a.left) as f64;
+        let r = a.right as f64 + u * (b.right - a.right) as f64;
+        (l, r)
+    }
+
+    /// Cumulative ticks (left, right) at `t`, or why they are not known well enough.
+    pub fn ticks_at(&self, t: f64, max_gap: f64) -> Result<(f64, f64), DiscardReason> {
+        let i = self.bracket(t, max_gap)?;
+        Ok(self.ticks_between(i, t))
+    }
+
+    /// The wheel motion over `[t0, t1]` (encoder clock), with its profile.
+    pub fn motion(
+        &self,
+        t0: f64,
+        t1: f64,
+        limits: &SyncLimits,
+    ) -> Result<WheelMotion, DiscardReason> {
+        if !(t1 > t0) || t1 - t0 > limits.max_interval {
+            return Err(DiscardReason::IntervalTooLong);
+        }
+        let i0 = self.bracket(t0, limits.max_encoder_gap)?;
+        let i1 = self.bracket(t1, limits.max_encoder_gap)?;
+        let (l0, r0) = self.ticks_between(i0, t0);
+        let (l1, r1) = self.ticks_between(i1, t1);
+        let (dl, dr) = (l1 - l0, r1 - r0);
+        if dl.abs() < limits.still_ticks && dr.abs() < limits.still_ticks {
+            return Err(DiscardReason::RobotStill);
+        }
+        // Records strictly inside (t0, t1) are records[i0 .. i1] (those with t ≤ t1
+        // after i0); the last may sit exactly at t1, which then closes the interval.
+        let mut profile = Vec::with_capacity(i1 - i0 + 1);
+        let (mut tp, mut lp, mut rp) = (t0, l0, r0);
+        for rec in &self.records[i0..i1] {
+            if rec.t >= t1 {
+                break;
+            }
+            if rec.t - tp > limits.max_encoder_gap {
+                return Err(DiscardReason::EncoderGap);
+            }
+            let (l, r) = (rec.left as f64, rec.right as f64);
+            if rec.t > tp {
+                profile.push(self.piece(rec.t - tp, l - lp, r - rp));
+            }
+            (tp, lp, rp) = (rec.t, l, r);
+        }
+        if t1 > tp {
+            profile.push(self.piece(t1 - tp, l1 - lp, r1 - rp));
+        }
+        Ok(WheelMotion {
+            t0,
+            dt: t1 - t0,
+            dphi_l: dl * self.rad_per_tick,
+            dphi_r: dr * self.rad_per_tick,
+            profile,
+        })
+    }
+
+    fn piece(&self, dt: f64, dl: f64, dr: f64) -> ProfilePiece {
+        ProfilePiece {
+            dt,
+            dphi_l: dl * self.rad_per_tick,
+            dphi_r: dr * self.rad_per_tick,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rec(t: f64, left: i64, right: i64) -> EncoderRecord {
+        EncoderRecord {
+            t,
+            left,
+            right,
+            line: 0,
+        }
+    }
+
+    fn limits() -> SyncLimits {
+        SyncLimits {
+            max_encoder_gap: 0.05,
+            still_ticks: 1.0,
+            max_interval: 1.0,
+        }
+    }
+
+    /// Records every 10 ms of a left wheel at 100 ticks/s and right at −50 ticks/s.
+    fn linear_records(n: usize) -> Vec<EncoderRecord> {
+        (0..n)
+            .map(|k| rec(k as f64 * 0.01, k as i64, -(k as i64 / 2)))
+            .collect()
+    }
+
+    #[test]
+    fn default_stride_aims_at_0_4_seconds() {
+        let t10: Vec<f64> = (0..100).map(|i| i as f64 * 0.1).collect();
+        assert_eq!(default_stride(&t10), 4);
+        let t5: Vec<f64> = (0..100).map(|i| i as f64 * 0.2).collect();
+        assert_eq!(default_stride(&t5), 2);
+        let t1: Vec<f64> = (0..100).map(|i| i as f64 * 1.0).collect();
+        assert_eq!(default_stride(&t1), 1);
+        assert_eq!(default_stride(&[1.0]), 1);
+    }
+
+    #[test]
+    fn pairs_do_not_overlap() {
+        let t: Vec<f64> = (0..10).map(|i| i as f64).collect();
+        let p = scan_pairs(&t, 3);
+        let idx: Vec<(usize, usize)> = p.iter().map(|p| (p.first, p.second)).collect();
+        assert_eq!(idx, vec![(0, 3), (3, 6), (6, 9)]);
+        assert_eq!(scan_pairs(&t, 1).len(), 9);
+        assert!(scan_pairs(&t[..1], 1).is_empty());
+    }
+
+    #[test]
+    fn interpolation_is_exact_on_linear_ticks() {
+        let recs: Vec<EncoderRecord> = (0..101)
+            .map(|k| rec(k as f64 * 0.01, 3 * k, -2 * k))
+            .collect();
+        let track = EncoderTrack::new(&recs, 100.0);
+        let (l, r) = track.ticks_at(0.123, 0.05).unwrap();
+        assert!((l - 36.9).abs() < 1e-9 && (r + 24.6).abs() < 1e-9);
+        let m = track.motion(0.105, 0.5055, &limits()).unwrap();
+        let per = std::f64::consts::TAU / 100.0;
+        assert!((m.dt - 0.4005).abs() < 1e-12);
+        assert!((m.dphi_l - 300.0 * 0.4005 * per).abs() < 1e-9);
+        assert!((m.dphi_r + 200.0 * 0.4005 * per).abs() < 1e-9);
+        // Profile: partial piece, 39 whole pieces, partial piece; sums match.
+        assert_eq!(m.profile.len(), 41);
+        let s: (f64, f64, f64) = m.profile.iter().fold((0.0, 0.0, 0.0), |a, p| {
+            (a.0 + p.dt, a.1 + p.dphi_l, a.2 + p.dphi_r)
+        });
+        assert!((s.0 - m.dt).abs() < 1e-12);
+        assert!((s.1 - m.dphi_l).abs() < 1e-9 && (s.2 - m.dphi_r).abs() < 1e-9);
+        assert!(m.profile.iter().all(|p| p.dt > 0.0 && p.dt <= 0.01 + 1e-12));
+    }
+
+    #[test]
+    fn profile_follows_speed_changes() {
+        // Left wheel: 0 ticks/record for 20 records then 10 ticks/record.
+        let recs: Vec<EncoderRecord> = (0..60)
+            .map(|k| rec(k as f64 * 0.01, if k < 20 { 0 } else { 10 * (k - 20) }, k))
+            .collect();
+        let track = EncoderTrack::new(&recs, 1000.0);
+        let m = track.motion(0.1, 0.4, &limits()).unwrap();
+        let per = std::f64::consts::TAU / 1000.0;
+        assert!((m.dphi_l - 200.0 * per).abs() < 1e-12);
+        let early: f64 = m.profile.iter().take(10).map(|p| p.dphi_l).sum();
+        assert_eq!(early, 0.0);
+        assert!(m.profile[15].dphi_l > 0.0);
+    }
+
+    #[test]
+    fn records_at_the_interval_ends() {
+        let recs: Vec<EncoderRecord> = (0..11)
+            .map(|k| rec(k as f64 * 0.1, 10 * k, 10 * k))
+            .collect();
+        let track = EncoderTrack::new(&recs, 100.0);
+        let lim = SyncLimits {
+            max_encoder_gap: 0.2,
+            ..limits()
+        };
+        let m = track.motion(0.2, 1.0, &lim).unwrap();
+        assert_eq!(m.profile.len(), 8);
+        assert!((m.dphi_l - 80.0 * std::f64::consts::TAU / 100.0).abs() < 1e-12);
+        assert!(track.motion(0.2, 1.0001, &lim).is_err());
+    }
+
+    #[test]
+    fn discard_reasons() {
+        let recs = linear_records(200);
+        let track = EncoderTrack::new(&recs, 100.0);
+        let lim = limits();
+        // Outside the stream.
+        assert_eq!(
+            track.motion(-0.5, 0.1, &lim).unwrap_err(),
+            DiscardReason::EncoderGap
+        );
+        assert_eq!(
+            track.motion(1.8, 2.5, &lim).unwrap_err(),
+            DiscardReason::EncoderGap
+        );
+        // Too long.
+        assert_eq!(
+            track.motion(0.1, 1.5, &lim).unwrap_err(),
+            DiscardReason::IntervalTooLong
+        );
+        assert_eq!(
+            track.motion(0.5, 0.5, &lim).unwrap_err(),
+            DiscardReason::IntervalTooLong
+        );
+        // Still: less than one tick on each wheel.
+        assert_eq!(
+            track.motion(0.101, 0.1085, &lim).unwrap_err(),
+            DiscardReason::RobotStill
+        );
+        // A hole in the stream around a scan timestamp and inside an interval.
+        let mut holed = linear_records(200);
+        holed.drain(50..60);
+        let track = EncoderTrack::new(&holed, 100.0);
+        assert_eq!(
+            track.ticks_at(0.55, 0.05).unwrap_err(),
+            DiscardReason::EncoderGap
+        );
+        assert_eq!(
+            track.motion(0.3, 0.55, &lim).unwrap_err(),
+            DiscardReason::EncoderGap
+        );
+        let wide = SyncLimits {
+            max_encoder_gap: 0.2,
+            ..lim
+        };
+        assert!(track.motion(0.3, 0.7, &wide).is_ok());
+        let strict = SyncLimits {
+            max_encoder_gap: 0.05,
+            ..lim
+        };
+        assert_eq!(
+            track.motion(0.3, 0.7, &strict).unwrap_err(),
+            DiscardReason::EncoderGap
+        );
+    }
+
+    #[test]
+    fn duplicate_timestamps_do_not_divide_by_zero() {
+        let recs = vec![
+            rec(0.0, 0, 0),
+            rec(0.1, 5, 5),
+            rec(0.1, 6, 6),
+            rec(0.2, 10, 10),
+        ];
+        let track = EncoderTrack::new(&recs, 100.0);
+        let m = track
+            .motion(
+                0.05,
+                0.15,
+                &SyncLimits {
+                    max_encoder_gap: 0.2,
+                    ..limits()
+                },
+            )
+            .unwrap();
+        assert!(m.dphi_l.is_finite() && m.profile.iter().all(|p| p.dphi_l.is_finite()));
+    }
+
+    #[test]
+    fn counts_have_every_reason() {
+        let mut c = DiscardCounts::default();
+        c.add(DiscardReason::MatchFailed);
+        c.add(DiscardReason::MatchFailed);
+        assert_eq!(c.get(DiscardReason::MatchFailed), 2);
+        assert_eq!(c.total(), 2);
+        let json = serde_json::to_string(&c).unwrap();
+        assert_eq!(
+            json,
+            r#"{"encoder_gap":0,"interval_too_long":0,"match_failed":2,"robot_still":0}"#
+        );
+    }
+}
