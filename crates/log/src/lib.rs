@@ -16,7 +16,9 @@ mod error;
 mod json_stream;
 mod model;
 mod tuple;
+mod writer;
 
 pub use error::{LogError, MissingData};
 pub use model::*;
 pub use tuple::{read_tuples, read_tuples_from, write_tuple, TupleRecord};
+pub use writer::{write_log, LogWriter, RobotLaserPoses};

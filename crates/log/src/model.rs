@@ -117,6 +117,12 @@ pub struct ScanGeometry {
     pub angles: Arc<[f64]>,
 }
 
+/// True when `a` and `b` are the same number, NaN included (geometries compare by bits
+/// so that a NaN field cannot make a geometry unequal to itself).
+fn same_f64(a: f64, b: f64) -> bool {
+    a.to_bits() == b.to_bits()
+}
+
 impl ScanGeometry {
     /// A geometry with its angle table computed from `start_angle` and `resolution`.
     #[allow(clippy::too_many_arguments)]
@@ -154,6 +160,67 @@ impl ScanGeometry {
         ScanGeometry::new(2, -340.0 * res, 680.0 * res, res, 4.0, 0.02, 0.01, 0, 681)
     }
 
+    /// A geometry with an explicit angle table (rays need not be evenly spaced, as in
+    /// the original package's JSON logs). `start_angle`, `resolution` and `fov` are
+    /// derived from the first and last angles.
+    pub fn from_angles(angles: Vec<f64>, max_range: f64, min_range: f64) -> Self {
+        let n = angles.len();
+        let start_angle = angles.first().copied().unwrap_or(0.0);
+        let fov = if n > 1 {
+            angles[n - 1] - start_angle
+        } else {
+            0.0
+        };
+        let resolution = if n > 1 { fov / (n - 1) as f64 } else { 0.0 };
+        ScanGeometry {
+            laser_type: 0,
+            start_angle,
+            resolution,
+            fov,
+            max_range,
+            min_range,
+            accuracy: 0.0,
+            remission_mode: 0,
+            angles: angles.into(),
+        }
+    }
+
+    /// True when the angle table is `start_angle + i · resolution` for every ray, so that
+    /// a RAWLASER1 line can describe it exactly.
+    pub fn is_evenly_spaced(&self) -> bool {
+        self.angles
+            .iter()
+            .enumerate()
+            .all(|(i, &a)| same_f64(a, self.start_angle + i as f64 * self.resolution))
+    }
+
+    /// True when the logged fields equal the given ones (the angle table is then equal
+    /// too, being computed from them). Used by the reader to reuse a geometry without
+    /// building a new angle table.
+    #[allow(clippy::too_many_arguments)]
+    pub fn has_fields(
+        &self,
+        laser_type: i32,
+        start_angle: f64,
+        fov: f64,
+        resolution: f64,
+        max_range: f64,
+        min_range: f64,
+        accuracy: f64,
+        remission_mode: i32,
+        num_readings: usize,
+    ) -> bool {
+        self.laser_type == laser_type
+            && same_f64(self.start_angle, start_angle)
+            && same_f64(self.fov, fov)
+            && same_f64(self.resolution, resolution)
+            && same_f64(self.max_range, max_range)
+            && same_f64(self.min_range, min_range)
+            && same_f64(self.accuracy, accuracy)
+            && self.remission_mode == remission_mode
+            && self.num_readings() == num_readings
+    }
+
     /// Number of readings per scan.
     pub fn num_readings(&self) -> usize {
         self.angles.len()
@@ -189,6 +256,10 @@ pub struct ScanMeta {
     pub kind: ScanKind,
     /// 1-based line number in the source (0 when not from a file).
     pub line: u64,
+    /// Offset of the first remission in [`ScanStore::remissions`].
+    pub remission_offset: usize,
+    /// Number of remissions logged with this scan (usually 0).
+    pub num_remissions: u32,
 }
 
 /// All scans of a log: ranges packed as `f32`, one geometry per distinct sensor setup.
@@ -213,6 +284,8 @@ pub struct ScanRef<'a> {
     pub geometry: &'a ScanGeometry,
     /// Its readings (m), one per angle.
     pub ranges: &'a [f32],
+    /// Remission values logged with the scan (usually empty).
+    pub remissions: &'a [f32],
     /// Message kind it came from.
     pub kind: ScanKind,
     /// 1-based source line.
@@ -238,7 +311,10 @@ impl ScanStore {
         Some(ScanRef {
             t: m.t,
             geometry: g,
-            ranges: &self.ranges[m.offset..m.offset + n],
+            ranges: self.ranges.get(m.offset..m.offset + n)?,
+            remissions: self
+                .remissions
+                .get(m.remission_offset..m.remission_offset + m.num_remissions as usize)?,
             kind: m.kind,
             line: m.line,
         })
@@ -260,29 +336,74 @@ impl ScanStore {
         kind: ScanKind,
         line: u64,
     ) {
+        self.push_with_remissions(t, geometry, ranges, &[], kind, line);
+    }
+
+    /// Appends a scan with its remissions, reusing an equal geometry when one is stored.
+    ///
+    /// `ranges.len()` must equal `geometry.num_readings()`.
+    pub fn push_with_remissions(
+        &mut self,
+        t: f64,
+        geometry: &ScanGeometry,
+        ranges: &[f32],
+        remissions: &[f32],
+        kind: ScanKind,
+        line: u64,
+    ) {
         debug_assert_eq!(ranges.len(), geometry.num_readings());
-        let gi = match self.geometries.iter().position(|g| g == geometry) {
-            Some(i) => i,
+        let gi = self.geometry_index(geometry);
+        self.ranges.extend_from_slice(ranges);
+        self.remissions.extend_from_slice(remissions);
+        self.push_meta(t, gi, ranges.len(), remissions.len(), kind, line);
+    }
+
+    /// The index of `geometry` in [`ScanStore::geometries`], adding it when new.
+    pub fn geometry_index(&mut self, geometry: &ScanGeometry) -> u32 {
+        match self.geometries.iter().position(|g| g == geometry) {
+            Some(i) => i as u32,
             None => {
                 self.geometries.push(geometry.clone());
-                self.geometries.len() - 1
+                (self.geometries.len() - 1) as u32
             }
-        };
-        let offset = self.ranges.len();
-        self.ranges.extend_from_slice(ranges);
+        }
+    }
+
+    /// Records a scan whose `num_ranges` readings and `num_remissions` remissions were
+    /// just appended to [`ScanStore::ranges`] and [`ScanStore::remissions`] by the
+    /// caller (the reader parses straight into them).
+    pub(crate) fn push_meta(
+        &mut self,
+        t: f64,
+        geometry: u32,
+        num_ranges: usize,
+        num_remissions: usize,
+        kind: ScanKind,
+        line: u64,
+    ) {
         self.scans.push(ScanMeta {
             t,
-            geometry: gi as u32,
-            offset,
+            geometry,
+            offset: self.ranges.len() - num_ranges,
             kind,
             line,
+            remission_offset: self.remissions.len() - num_remissions,
+            num_remissions: num_remissions as u32,
         });
+    }
+
+    /// Sorts the scans by timestamp (stable: equal timestamps keep file order). The
+    /// ranges stay where they are; only the metadata moves.
+    pub fn sort_by_time(&mut self) {
+        self.scans.sort_by(|a, b| a.t.total_cmp(&b.t));
     }
 }
 
 /// What the reader saw besides the data: counts, skipped lines, warnings.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct ReadStats {
+    /// The file (or stream name) the log was read from.
+    pub source: String,
     /// Total lines read.
     pub lines: u64,
     /// Comment lines (`#`).
@@ -320,4 +441,28 @@ pub struct Log {
     pub scans: ScanStore,
     /// What the reader counted.
     pub stats: ReadStats,
+}
+
+impl Log {
+    /// Checks that the log holds what calibration needs: at least one ENCODER record,
+    /// at least two scans, and ticks per revolution (from a PARAM or the caller).
+    /// Returns the ticks per revolution.
+    pub fn check_calibration_inputs(&self) -> Result<f64, crate::LogError> {
+        let missing = |what| crate::LogError::MissingData {
+            file: self.stats.source.clone(),
+            what,
+        };
+        if self.encoders.is_empty() {
+            return Err(missing(crate::MissingData::NoEncoderRecords));
+        }
+        if self.scans.len() < 2 {
+            return Err(missing(crate::MissingData::TooFewScans {
+                found: self.scans.len(),
+            }));
+        }
+        match &self.params.ticks_per_revolution {
+            Some((ticks, _)) => Ok(*ticks),
+            None => Err(missing(crate::MissingData::NoTicksPerRevolution)),
+        }
+    }
 }
