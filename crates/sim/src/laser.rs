@@ -1,0 +1,298 @@
+//! The range finder: a Hokuyo URG-04LX by default (681 rays, 2π/1024 rad apart,
+//! ±120°, 4 m), with correlated Gaussian range noise, quantization and failures
+//! reported as 0.
+
+use crate::error::SimError;
+use crate::world::World;
+use odocal_geom::Pose2;
+use odocal_log::ScanGeometry;
+use rand::Rng;
+use rand_distr::StandardNormal;
+use serde::{Deserialize, Serialize};
+
+/// Geometry, rate and error model of the simulated laser.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LaserConfig {
+    /// Number of rays per scan.
+    pub num_rays: usize,
+    /// Angle of ray 0 in the sensor frame (rad).
+    pub start_angle: f64,
+    /// Angle between consecutive rays (rad).
+    pub resolution: f64,
+    /// Maximum range (m): farther walls, and readings at or above it, give 0.
+    pub max_range: f64,
+    /// Minimum range (m): readings at or below it give 0.
+    pub min_range: f64,
+    /// Scans per second.
+    pub rate_hz: f64,
+    /// Scan timing jitter: each scan time is moved by a uniform amount in ±jitter (s).
+    pub jitter_s: f64,
+    /// Standard deviation of the range noise of each reading (m); 0 = noise-free.
+    pub range_sigma: f64,
+    /// Number of neighbouring rays the noise is correlated over: the noise of ray `i`
+    /// is the normalised sum of `correlation_rays` consecutive white-noise values, so
+    /// neighbours closer than that share part of their error (1 = independent).
+    pub correlation_rays: usize,
+    /// Ranges are rounded to a multiple of this (m); 0 = no rounding.
+    pub quantization: f64,
+    /// Probability that a reading fails at random (reported as 0).
+    pub dropout_probability: f64,
+}
+
+impl Default for LaserConfig {
+    /// The URG-04LX: 681 rays, 2π/1024 rad apart from −340·2π/1024, 0.02–4 m, 10 Hz,
+    /// σ = 3 mm correlated over 4 rays, 1 mm quantization, 0.1 % random failures.
+    fn default() -> Self {
+        let res = std::f64::consts::TAU / 1024.0;
+        LaserConfig {
+            num_rays: 681,
+            start_angle: -340.0 * res,
+            resolution: res,
+            max_range: 4.0,
+            min_range: 0.02,
+            rate_hz: 10.0,
+            jitter_s: 0.0,
+            range_sigma: 0.003,
+            correlation_rays: 4,
+            quantization: 0.001,
+            dropout_probability: 0.001,
+        }
+    }
+}
+
+impl LaserConfig {
+    /// The same sensor without any error: exact ranges (up to `f32` rounding), no
+    /// quantization, no random failures.
+    pub fn noise_free() -> Self {
+        LaserConfig {
+            range_sigma: 0.0,
+            quantization: 0.0,
+            dropout_probability: 0.0,
+            ..LaserConfig::default()
+        }
+    }
+
+    /// The scan geometry as written to the log (laser type 2 = Hokuyo URG).
+    pub fn geometry(&self) -> ScanGeometry {
+        ScanGeometry::new(
+            2,
+            self.start_angle,
+            (self.num_rays.saturating_sub(1)) as f64 * self.resolution,
+            self.resolution,
+            self.max_range,
+            self.min_range,
+            self.range_sigma,
+            0,
+            self.num_rays,
+        )
+    }
+
+    /// Ray angles in the sensor frame (rad).
+    pub fn angles(&self) -> Vec<f64> {
+        (0..self.num_rays)
+            .map(|i| self.start_angle + i as f64 * self.resolution)
+            .collect()
+    }
+
+    /// Checks that every setting is meaningful.
+    pub fn validate(&self) -> Result<(), SimError> {
+        let bad = |field, value: f64, expected| {
+            Err(SimError::InvalidConfig {
+                field,
+                value: value.to_string(),
+                expected,
+            })
+        };
+        if self.num_rays == 0 {
+            return bad("laser.num_rays", 0.0, "at least one ray");
+        }
+        if !(self.resolution.is_finite() && self.resolution > 0.0) {
+            return bad(
+                "laser.resolution",
+                self.resolution,
+                "a positive angle (rad)",
+            );
+        }
+        if !self.start_angle.is_finite() {
+            return bad(
+                "laser.start_angle",
+                self.start_angle,
+                "a finite angle (rad)",
+            );
+        }
+        if !(self.max_range.is_finite() && self.max_range > self.min_range && self.min_range >= 0.0)
+        {
+            return bad(
+                "laser.max_range",
+                self.max_range,
+                "finite, above min_range ≥ 0",
+            );
+        }
+        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0 && self.rate_hz <= 1000.0) {
+            return bad("laser.rate_hz", self.rate_hz, "a rate in (0, 1000] Hz");
+        }
+        if !(self.jitter_s.is_finite()
+            && self.jitter_s >= 0.0
+            && self.jitter_s < 0.5 / self.rate_hz)
+        {
+            return bad(
+                "laser.jitter_s",
+                self.jitter_s,
+                "≥ 0 and below half the scan period",
+            );
+        }
+        if !(self.range_sigma.is_finite() && self.range_sigma >= 0.0) {
+            return bad(
+                "laser.range_sigma",
+                self.range_sigma,
+                "a standard deviation ≥ 0 (m)",
+            );
+        }
+        if self.correlation_rays == 0 {
+            return bad("laser.correlation_rays", 0.0, "at least 1 ray");
+        }
+        if !(self.quantization.is_finite() && self.quantization >= 0.0) {
+            return bad("laser.quantization", self.quantization, "a step ≥ 0 (m)");
+        }
+        if !(0.0..=1.0).contains(&self.dropout_probability) {
+            return bad(
+                "laser.dropout_probability",
+                self.dropout_probability,
+                "a probability in [0, 1]",
+            );
+        }
+        Ok(())
+    }
+
+    /// The exact ranges (m) seen from `sensor_pose` (world frame): `f64::INFINITY`
+    /// where no wall is within `max_range`.
+    pub fn true_ranges(&self, world: &World, sensor_pose: &Pose2) -> Vec<f64> {
+        world.cast_fan(
+            [sensor_pose.x, sensor_pose.y],
+            sensor_pose.theta,
+            &self.angles(),
+            self.max_range,
+        )
+    }
+
+    /// One scan as the sensor reports it from `sensor_pose`: the true ranges plus
+    /// correlated noise, quantized, with failures (nothing within range, reading out
+    /// of `(min_range, max_range)`, random dropout) reported as 0.
+    ///
+    /// With [`LaserConfig::noise_free`] this uses no randomness at all.
+    pub fn scan<R: Rng + ?Sized>(
+        &self,
+        world: &World,
+        sensor_pose: &Pose2,
+        rng: &mut R,
+    ) -> Vec<f32> {
+        let truth = self.true_ranges(world, sensor_pose);
+        let noise = self.correlated_noise(rng);
+        truth
+            .iter()
+            .zip(&noise)
+            .map(|(&r, &e)| {
+                let failed = self.dropout_probability > 0.0
+                    && rng.random::<f64>() < self.dropout_probability;
+                if !r.is_finite() || failed {
+                    return 0.0;
+                }
+                let mut m = r + e;
+                if self.quantization > 0.0 {
+                    m = (m / self.quantization).round() * self.quantization;
+                }
+                if m <= self.min_range || m >= self.max_range {
+                    0.0
+                } else {
+                    m as f32
+                }
+            })
+            .collect()
+    }
+
+    /// Per-ray noise (m): a moving sum of `correlation_rays` white Gaussian values,
+    /// scaled so that each ray's standard deviation is `range_sigma`.
+    fn correlated_noise<R: Rng + ?Sized>(&self, rng: &mut R) -> Vec<f64> {
+        if self.range_sigma == 0.0 {
+            return vec![0.0; self.num_rays];
+        }
+        let w = self.correlation_rays;
+        let white: Vec<f64> = (0..self.num_rays + w - 1)
+            .map(|_| rng.sample::<f64, _>(StandardNormal))
+            .collect();
+        let scale = self.range_sigma / (w as f64).sqrt();
+        let mut sum: f64 = white[..w].iter().sum();
+        let mut out = Vec::with_capacity(self.num_rays);
+        for i in 0..self.num_rays {
+            if i > 0 {
+                sum += white[i + w - 1] - white[i - 1];
+            }
+            out.push(sum * scale);
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn geometry_is_the_urg_04lx() {
+        let g = LaserConfig::default().geometry();
+        let urg = ScanGeometry::urg_04lx();
+        assert!(g.same_rays(&urg));
+        assert!((g.angles[0] + 2.0 * std::f64::consts::PI / 3.0).abs() < 0.01);
+        assert!((g.angles[680] - 2.0 * std::f64::consts::PI / 3.0).abs() < 0.01);
+    }
+
+    #[test]
+    fn noise_has_the_announced_spread_and_correlation() {
+        let cfg = LaserConfig::default();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut n = 0.0;
+        let (mut s2, mut c1, mut c4) = (0.0, 0.0, 0.0);
+        for _ in 0..300 {
+            let e = cfg.correlated_noise(&mut rng);
+            for i in 0..e.len() - 4 {
+                s2 += e[i] * e[i];
+                c1 += e[i] * e[i + 1];
+                c4 += e[i] * e[i + 4];
+                n += 1.0;
+            }
+        }
+        let sigma = (s2 / n).sqrt();
+        assert!((sigma - 0.003).abs() < 0.0001, "sigma {sigma}");
+        // Moving sum over 4: neighbour correlation 3/4, none at lag 4.
+        assert!((c1 / s2 - 0.75).abs() < 0.02, "rho1 {}", c1 / s2);
+        assert!((c4 / s2).abs() < 0.02, "rho4 {}", c4 / s2);
+    }
+
+    #[test]
+    fn failures_are_zero_and_readings_quantized() {
+        let world = World::corridor();
+        let cfg = LaserConfig {
+            dropout_probability: 0.05,
+            ..LaserConfig::default()
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(9);
+        // Looking along the corridor: the far end is beyond 4 m.
+        let scan = cfg.scan(&world, &Pose2::new(20.0, 1.0, 0.0), &mut rng);
+        let zeros = scan.iter().filter(|&&r| r == 0.0).count();
+        assert!(zeros > 20);
+        for &r in &scan {
+            if r != 0.0 {
+                let mm = r as f64 * 1000.0;
+                assert!((mm - mm.round()).abs() < 1e-3, "{r}");
+                assert!(r > 0.02 && r < 4.0);
+            }
+        }
+        // The ray straight ahead (index 340) never reaches the end wall.
+        assert_eq!(
+            LaserConfig::noise_free().scan(&world, &Pose2::new(20.0, 1.0, 0.0), &mut rng)[340],
+            0.0
+        );
+    }
+}
