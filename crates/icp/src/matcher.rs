@@ -1,0 +1,252 @@
+//! The ICP loop: correspondences, trimming, exact step, until the estimate settles.
+
+use crate::correspondence::{nearest_by_angle, nearest_by_tree, segment_for};
+use crate::covariance::InformationSum;
+use crate::solve_step::NormalEquations;
+use crate::trimming::threshold;
+use crate::{IcpError, IcpParams, NeighbourSearch, PreparedScan};
+use odocal_geom::{wrap_angle, Pose2};
+
+/// Outcome of a successful match.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IcpResult {
+    /// ŝ: the pose of the current sensor frame in the reference sensor frame.
+    pub pose: Pose2,
+    /// Covariance of `pose` as `[x, y, θ]` (m², m·rad, rad²); Hessian-based, see the crate documentation.
+    pub covariance: [[f64; 3]; 3],
+    /// Iterations done (each: correspondences + one exact step).
+    pub iterations: u32,
+    /// Correspondences used in the final step (after trimming).
+    pub correspondences: usize,
+    /// Mean absolute point-to-line residual of the used correspondences (m).
+    pub mean_residual: f64,
+    /// Residual standard deviation σ̂ that scales the covariance (m).
+    pub residual_sigma: f64,
+    /// Condition number of the scale-normalised information matrix.
+    pub condition_number: f64,
+    /// True when `condition_number > max_condition_number`: some direction (see
+    /// `weakest_direction`) is poorly constrained — e.g. along a corridor.
+    pub ill_conditioned: bool,
+    /// Unit vector `(x, y, ρ·θ)` of the least constrained direction (ρ: RMS range of
+    /// the used points).
+    pub weakest_direction: [f64; 3],
+}
+
+/// One used-or-not correspondence of the current iteration.
+#[derive(Debug, Clone, Copy)]
+struct Correspondence {
+    /// Current point in the current sensor frame.
+    q: [f64; 2],
+    /// Reference line.
+    normal: [f64; 2],
+    offset: f64,
+    /// Signed point-to-line distance at the estimate of this iteration.
+    residual: f64,
+}
+
+/// Point-to-line ICP with its scratch buffers (reused: no allocation per iteration
+/// once warmed up). Use one per thread.
+#[derive(Debug, Clone)]
+pub struct Matcher {
+    params: IcpParams,
+    correspondences: Vec<Correspondence>,
+    abs_residuals: Vec<f64>,
+    /// Per valid current point: the reference ray where the last search ended.
+    search_start: Vec<u32>,
+}
+
+impl Matcher {
+    /// A matcher with these parameters (checked by [`Matcher::match_scans`]).
+    pub fn new(params: IcpParams) -> Self {
+        Matcher {
+            params,
+            correspondences: Vec::new(),
+            abs_residuals: Vec::new(),
+            search_start: Vec::new(),
+        }
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &IcpParams {
+        &self.params
+    }
+
+    /// Estimates ŝ, the pose of `current`'s sensor in `reference`'s sensor frame,
+    /// starting from `first_guess` (e.g. from odometry).
+    pub fn match_scans(
+        &mut self,
+        reference: &PreparedScan,
+        current: &PreparedScan,
+        first_guess: Pose2,
+    ) -> Result<IcpResult, IcpError> {
+        let params = self.params.clone();
+        params.validate()?;
+        if !first_guess.is_finite() {
+            return Err(IcpError::NonFiniteGuess(first_guess));
+        }
+        let use_tree = params.search == NeighbourSearch::KdTree || !reference.angles_increasing;
+        if use_tree && reference.tree.is_none() {
+            return Err(IcpError::InvalidParams(
+                "k-d tree search asked for, but the reference scan was prepared without it \
+                 (prepare it with search = KdTree)"
+                    .to_string(),
+            ));
+        }
+        let gate2 = params.max_correspondence_dist * params.max_correspondence_dist;
+        let rho_max = current.max_valid_range;
+
+        // First guess of the reference ray for each current point: its bearing turned
+        // by the guessed rotation (the walk then corrects for the translation).
+        self.search_start.clear();
+        for &i in &current.valid_indices {
+            let bearing = current.angles[i as usize] + first_guess.theta;
+            self.search_start
+                .push(reference.ray_near_bearing(bearing) as u32);
+        }
+
+        let mut estimate = first_guess;
+        let mut previous_motion: Option<f64> = None;
+        let mut tau = f64::INFINITY;
+        let mut iterations = 0;
+        let mut converged = false;
+        let mut last_step = (f64::INFINITY, f64::INFINITY);
+        while iterations < params.max_iterations {
+            iterations += 1;
+            self.find_correspondences(reference, current, &estimate, gate2, use_tree);
+            let found = self.correspondences.len();
+            if found < params.min_correspondences {
+                return Err(IcpError::TooFewCorrespondences {
+                    found,
+                    needed: params.min_correspondences,
+                    iteration: iterations,
+                });
+            }
+            self.abs_residuals.clear();
+            self.abs_residuals
+                .extend(self.correspondences.iter().map(|c| c.residual.abs()));
+            tau = threshold(&mut self.abs_residuals, &params, previous_motion, tau);
+
+            let mut equations = NormalEquations::new();
+            let mut used = 0;
+            for c in self.correspondences.iter().filter(|c| c.residual.abs() <= tau) {
+                equations.add(c.q, c.normal, c.offset);
+                used += 1;
+            }
+            if used < params.min_correspondences {
+                return Err(IcpError::TooFewCorrespondences {
+                    found: used,
+                    needed: params.min_correspondences,
+                    iteration: iterations,
+                });
+            }
+            let next = equations.solve(&estimate).ok_or(IcpError::Numerical {
+                iteration: iterations,
+                what: "singular or non-finite point-to-line step",
+            })?;
+            let step = estimate.between(&next);
+            let step_xy = step.translation_norm();
+            let step_theta = step.theta.abs();
+            last_step = (step_xy, step_theta);
+            estimate = next;
+            previous_motion = Some(step_xy + rho_max * step_theta);
+            if step_xy <= params.epsilon_xy && step_theta <= params.epsilon_theta {
+                converged = true;
+                break;
+            }
+            // Hopelessly far: stop early (the final check reports it).
+            let off = first_guess.between(&estimate);
+            if off.translation_norm() > 3.0 * params.max_linear_correction
+                || off.theta.abs() > 3.0 * params.max_angular_correction
+            {
+                break;
+            }
+        }
+        let correction = first_guess.between(&estimate);
+        let (linear, angular) = (correction.translation_norm(), wrap_angle(correction.theta).abs());
+        if linear > params.max_linear_correction || angular > params.max_angular_correction {
+            return Err(IcpError::CorrectionTooLarge {
+                linear,
+                angular,
+                max_linear: params.max_linear_correction,
+                max_angular: params.max_angular_correction,
+            });
+        }
+        if !converged {
+            return Err(IcpError::FailedToConverge {
+                iterations,
+                last_step_xy: last_step.0,
+                last_step_theta: last_step.1,
+            });
+        }
+
+        // Uncertainty at the final estimate, over the correspondences used last.
+        let mut info = InformationSum::new(&estimate);
+        let (s, c) = estimate.theta.sin_cos();
+        let mut sum_abs = 0.0;
+        for k in self.correspondences.iter().filter(|k| k.residual.abs() <= tau) {
+            let p = [
+                estimate.x + c * k.q[0] - s * k.q[1],
+                estimate.y + s * k.q[0] + c * k.q[1],
+            ];
+            let e = k.normal[0] * p[0] + k.normal[1] * p[1] - k.offset;
+            sum_abs += e.abs();
+            info.add(k.q, k.normal, e);
+        }
+        let used = info.count();
+        let unc = info.finish().ok_or(IcpError::Numerical {
+            iteration: iterations,
+            what: "non-finite information matrix",
+        })?;
+        Ok(IcpResult {
+            pose: estimate,
+            covariance: unc.covariance,
+            iterations,
+            correspondences: used,
+            mean_residual: sum_abs / used.max(1) as f64,
+            residual_sigma: unc.residual_sigma,
+            condition_number: unc.condition_number,
+            ill_conditioned: !(unc.condition_number <= params.max_condition_number),
+            weakest_direction: unc.weakest_direction,
+        })
+    }
+
+    /// Fills `self.correspondences` for the estimate.
+    fn find_correspondences(
+        &mut self,
+        reference: &PreparedScan,
+        current: &PreparedScan,
+        estimate: &Pose2,
+        gate2: f64,
+        use_tree: bool,
+    ) {
+        self.correspondences.clear();
+        let (s, c) = estimate.theta.sin_cos();
+        for (k, &i) in current.valid_indices.iter().enumerate() {
+            let q = current.points[i as usize];
+            let p = [
+                estimate.x + c * q[0] - s * q[1],
+                estimate.y + s * q[0] + c * q[1],
+            ];
+            let nearest = if use_tree {
+                nearest_by_tree(reference, p, gate2)
+            } else {
+                nearest_by_angle(reference, p, self.search_start[k] as usize, gate2)
+            };
+            let Some(j) = nearest else { continue };
+            self.search_start[k] = j as u32;
+            let Some(seg) = segment_for(reference, p, j) else {
+                continue;
+            };
+            let Some(line) = reference.segments[seg] else {
+                continue;
+            };
+            let residual = line.normal[0] * p[0] + line.normal[1] * p[1] - line.offset;
+            self.correspondences.push(Correspondence {
+                q,
+                normal: line.normal,
+                offset: line.offset,
+                residual,
+            });
+        }
+    }
+}

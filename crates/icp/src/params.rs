@@ -1,0 +1,140 @@
+//! Tuning parameters of the matcher, with defaults for a Hokuyo URG-04LX.
+
+/// How the closest reference point of each current point is found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum NeighbourSearch {
+    /// Walk the reference scan's rays outward from the ray closest in bearing, stopping
+    /// when the bearing difference alone rules out anything closer (CSM's idea for
+    /// ordered range scans). Needs strictly increasing ray angles.
+    #[default]
+    Angular,
+    /// A k-d tree (kiddo) over the reference scan's valid points.
+    KdTree,
+}
+
+/// Tuning of [`crate::Matcher`] and [`crate::PreparedScan`].
+///
+/// Distances are in metres, angles in radians.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IcpParams {
+    /// Iterations before giving up with [`crate::IcpError::FailedToConverge`].
+    pub max_iterations: u32,
+    /// Converged when an iteration moves the estimate by less than this (m) …
+    pub epsilon_xy: f64,
+    /// … and turns it by less than this (rad).
+    pub epsilon_theta: f64,
+    /// A current point farther than this from every reference point gets no match (m).
+    pub max_correspondence_dist: f64,
+    /// At most this fraction of the matches (the ones with the smallest residuals) is
+    /// used; 1 disables the fractional trimming.
+    pub trim_fraction: f64,
+    /// Adaptive threshold: residuals above `outlier_sigma_mult · σ̂` are dropped, σ̂ being
+    /// the robust (median-based) spread of the residuals of the iteration.
+    pub outlier_sigma_mult: f64,
+    /// While far from convergence the threshold is at least `step_threshold_mult` times
+    /// the largest point motion of the previous iteration, so that a good part of the
+    /// matches is never thrown away only because the estimate is still moving.
+    pub step_threshold_mult: f64,
+    /// Readings at or below this range are invalid (m).
+    pub min_reading: f64,
+    /// Readings at or above this range are invalid (m).
+    pub max_reading: f64,
+    /// Fail if the result is farther than this from the first guess (m).
+    pub max_linear_correction: f64,
+    /// Fail if the result turns more than this from the first guess (rad).
+    pub max_angular_correction: f64,
+    /// Number of consecutive points over which the local line of a segment is fitted.
+    pub line_fit_window: usize,
+    /// A segment whose best local line fit has a larger RMS residual is not used (m).
+    pub max_line_fit_rms: f64,
+    /// Two consecutive valid points are on the same surface when they are closer than
+    /// `max(discontinuity_min_gap, discontinuity_gap_factor · range · Δangle)` (m) …
+    pub discontinuity_min_gap: f64,
+    /// … see [`IcpParams::discontinuity_min_gap`].
+    pub discontinuity_gap_factor: f64,
+    /// A scan with fewer valid readings is rejected.
+    pub min_valid_points: usize,
+    /// A match with fewer used correspondences is rejected.
+    pub min_correspondences: usize,
+    /// Above this condition number of the (scale-normalised) information matrix the
+    /// result is flagged `ill_conditioned`.
+    pub max_condition_number: f64,
+    /// Closest-point search method.
+    pub search: NeighbourSearch,
+}
+
+impl Default for IcpParams {
+    fn default() -> Self {
+        IcpParams {
+            max_iterations: 40,
+            epsilon_xy: 1e-8,
+            epsilon_theta: 1e-9,
+            max_correspondence_dist: 0.3,
+            trim_fraction: 0.95,
+            outlier_sigma_mult: 3.0,
+            step_threshold_mult: 3.0,
+            min_reading: 0.02,
+            max_reading: 4.0,
+            max_linear_correction: 0.3,
+            max_angular_correction: 30f64.to_radians(),
+            line_fit_window: 7,
+            max_line_fit_rms: 0.01,
+            discontinuity_min_gap: 0.05,
+            discontinuity_gap_factor: 10.0,
+            min_valid_points: 20,
+            min_correspondences: 20,
+            max_condition_number: 1e3,
+            search: NeighbourSearch::Angular,
+        }
+    }
+}
+
+impl IcpParams {
+    /// Checks that every parameter is in its meaningful range.
+    pub fn validate(&self) -> Result<(), crate::IcpError> {
+        let bad = |what: &str| Err(crate::IcpError::InvalidParams(what.to_string()));
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if self.max_iterations == 0 {
+            return bad("max_iterations must be at least 1");
+        }
+        if !(self.epsilon_xy.is_finite() && self.epsilon_xy >= 0.0)
+            || !(self.epsilon_theta.is_finite() && self.epsilon_theta >= 0.0)
+        {
+            return bad("epsilon_xy and epsilon_theta must be finite and non-negative");
+        }
+        if !positive(self.max_correspondence_dist) {
+            return bad("max_correspondence_dist must be positive");
+        }
+        if !(self.trim_fraction > 0.0 && self.trim_fraction <= 1.0) {
+            return bad("trim_fraction must be in (0, 1]");
+        }
+        if !positive(self.outlier_sigma_mult) || !positive(self.step_threshold_mult) {
+            return bad("outlier_sigma_mult and step_threshold_mult must be positive");
+        }
+        if !(self.min_reading.is_finite() && self.min_reading >= 0.0)
+            || self.max_reading.is_nan()
+            || self.max_reading <= self.min_reading
+        {
+            return bad("need 0 <= min_reading < max_reading");
+        }
+        if !positive(self.max_linear_correction) || !positive(self.max_angular_correction) {
+            return bad("max_linear_correction and max_angular_correction must be positive");
+        }
+        if self.line_fit_window < 2 {
+            return bad("line_fit_window must be at least 2");
+        }
+        if !positive(self.max_line_fit_rms) {
+            return bad("max_line_fit_rms must be positive");
+        }
+        if !positive(self.discontinuity_min_gap) || !positive(self.discontinuity_gap_factor) {
+            return bad("discontinuity_min_gap and discontinuity_gap_factor must be positive");
+        }
+        if self.min_valid_points < 3 || self.min_correspondences < 3 {
+            return bad("min_valid_points and min_correspondences must be at least 3");
+        }
+        if !positive(self.max_condition_number) {
+            return bad("max_condition_number must be positive");
+        }
+        Ok(())
+    }
+}

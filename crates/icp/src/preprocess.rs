@@ -1,0 +1,372 @@
+//! A scan made ready for matching, once, whatever role it plays later.
+//!
+//! Preparation turns ranges into Cartesian points, marks the invalid readings
+//! (0, non-finite, out of range), cuts the scan into runs of consecutive points on
+//! one surface (no run crosses a range discontinuity), and gives every segment
+//! between two consecutive points of a run a *local line*: the total-least-squares
+//! line of the window of `line_fit_window` consecutive run points containing both
+//! ends that fits best. Matching measures point-to-line distances to these lines
+//! rather than to the raw segment, whose direction two noisy points barely fix.
+//! On noise-free straight walls the local line is the wall itself.
+
+use crate::{IcpError, IcpParams, NeighbourSearch};
+use kiddo::immutable::float::kdtree::ImmutableKdTree;
+
+/// The line `normal · x = offset` of one segment, or nothing when it is not usable.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SegmentLine {
+    /// Unit normal, pointing towards the sensor.
+    pub normal: [f64; 2],
+    /// Signed distance of the line from the sensor along `normal`.
+    pub offset: f64,
+}
+
+/// The k-d tree over a scan's valid points (leaf size 32; items are indices into
+/// [`PreparedScan::valid_indices`]).
+pub(crate) type PointTree = ImmutableKdTree<f64, u32, 2, 32>;
+
+/// A scan preprocessed once, usable as reference or as current scan any number of times.
+#[derive(Debug, Clone)]
+pub struct PreparedScan {
+    /// Ray angles (rad).
+    pub(crate) angles: Vec<f64>,
+    /// Unit ray directions `(cos, sin)`.
+    pub(crate) dirs: Vec<[f64; 2]>,
+    /// Points in the sensor frame (NaN where invalid).
+    pub(crate) points: Vec<[f64; 2]>,
+    /// Validity of each reading.
+    pub(crate) valid: Vec<bool>,
+    /// Indices of the valid readings, increasing.
+    pub(crate) valid_indices: Vec<u32>,
+    /// `segments[i]`: the local line of the segment from point `i` to `i + 1`, if usable.
+    pub(crate) segments: Vec<Option<SegmentLine>>,
+    /// Angles strictly increasing (required by the angular search).
+    pub(crate) angles_increasing: bool,
+    /// `Some((first angle, step))` when the angles are uniformly spaced.
+    pub(crate) uniform: Option<(f64, f64)>,
+    /// Largest valid range (m).
+    pub(crate) max_valid_range: f64,
+    /// k-d tree over the valid points, built when the k-d search is asked for or the
+    /// angles do not allow the angular search.
+    pub(crate) tree: Option<PointTree>,
+}
+
+/// Window statistics of a local line fit.
+#[derive(Clone, Copy)]
+struct WindowFit {
+    line: SegmentLine,
+    rms: f64,
+}
+
+impl PreparedScan {
+    /// Prepares a scan: `ranges[i]` (m) measured along `angles[i]` (rad, sensor frame).
+    ///
+    /// A reading is valid when it is finite, non-zero, above both `min_range` and
+    /// `params.min_reading`, and below both `max_range` and `params.max_reading`.
+    /// Errors: arrays of different lengths, non-finite angles, invalid parameters, or
+    /// fewer than `params.min_valid_points` valid readings.
+    pub fn new(
+        ranges: &[f32],
+        angles: &[f64],
+        min_range: f64,
+        max_range: f64,
+        params: &IcpParams,
+    ) -> Result<PreparedScan, IcpError> {
+        params.validate()?;
+        if ranges.len() != angles.len() {
+            return Err(IcpError::InvalidScan(format!(
+                "{} ranges but {} angles",
+                ranges.len(),
+                angles.len()
+            )));
+        }
+        if let Some(i) = angles.iter().position(|a| !a.is_finite()) {
+            return Err(IcpError::InvalidScan(format!(
+                "angle {i} is not finite ({})",
+                angles[i]
+            )));
+        }
+        if min_range.is_nan() || max_range.is_nan() {
+            return Err(IcpError::InvalidScan(
+                "min_range and max_range must not be NaN".to_string(),
+            ));
+        }
+        let n = ranges.len();
+        let lo = min_range.max(params.min_reading);
+        let hi = max_range.min(params.max_reading);
+
+        let mut dirs = Vec::with_capacity(n);
+        let mut points = Vec::with_capacity(n);
+        let mut valid = Vec::with_capacity(n);
+        let mut valid_indices = Vec::with_capacity(n);
+        let mut max_valid_range: f64 = 0.0;
+        for (i, (&r, &a)) in ranges.iter().zip(angles).enumerate() {
+            let (s, c) = a.sin_cos();
+            dirs.push([c, s]);
+            let r = f64::from(r);
+            let ok = r.is_finite() && r != 0.0 && r > lo && r < hi;
+            valid.push(ok);
+            if ok {
+                points.push([r * c, r * s]);
+                valid_indices.push(i as u32);
+                max_valid_range = max_valid_range.max(r);
+            } else {
+                points.push([f64::NAN, f64::NAN]);
+            }
+        }
+        if valid_indices.len() < params.min_valid_points {
+            return Err(IcpError::TooFewValidPoints {
+                valid: valid_indices.len(),
+                total: n,
+                needed: params.min_valid_points,
+            });
+        }
+
+        let angles_increasing = angles.windows(2).all(|w| w[1] > w[0]);
+        let uniform = uniform_spacing(angles);
+        let connected = connections(ranges, angles, &points, &valid, params);
+        let segments = local_lines(&points, &connected, params);
+        let tree = if params.search == NeighbourSearch::KdTree || !angles_increasing {
+            let pts: Vec<[f64; 2]> = valid_indices.iter().map(|&i| points[i as usize]).collect();
+            Some(PointTree::new_from_slice(&pts))
+        } else {
+            None
+        };
+        Ok(PreparedScan {
+            angles: angles.to_vec(),
+            dirs,
+            points,
+            valid,
+            valid_indices,
+            segments,
+            angles_increasing,
+            uniform,
+            max_valid_range,
+            tree,
+        })
+    }
+
+    /// Number of readings (valid or not).
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// True when the scan has no readings (never, for a successfully prepared scan).
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// Number of valid readings.
+    pub fn valid_count(&self) -> usize {
+        self.valid_indices.len()
+    }
+
+    /// Number of segments with a usable local line.
+    pub fn usable_segment_count(&self) -> usize {
+        self.segments.iter().filter(|s| s.is_some()).count()
+    }
+
+    /// Point `i` in the sensor frame, `None` when the reading is invalid.
+    pub fn point(&self, i: usize) -> Option<[f64; 2]> {
+        (*self.valid.get(i)?).then(|| self.points[i])
+    }
+
+    /// Index of the ray whose angle is closest to `bearing` (rad, not wrapped).
+    pub(crate) fn ray_near_bearing(&self, bearing: f64) -> usize {
+        let n = self.angles.len();
+        let i = match self.uniform {
+            Some((a0, step)) => ((bearing - a0) / step).round(),
+            None => self.angles.partition_point(|&a| a < bearing) as f64,
+        };
+        if i.is_nan() || i <= 0.0 {
+            0
+        } else {
+            (i as usize).min(n - 1)
+        }
+    }
+}
+
+/// `Some((a0, step))` when `angles[i] = a0 + i·step` to within 1e-9 rad.
+fn uniform_spacing(angles: &[f64]) -> Option<(f64, f64)> {
+    let n = angles.len();
+    if n < 2 {
+        return None;
+    }
+    let step = (angles[n - 1] - angles[0]) / (n - 1) as f64;
+    if step <= 0.0 {
+        return None;
+    }
+    let uniform = angles
+        .iter()
+        .enumerate()
+        .all(|(i, &a)| (a - (angles[0] + i as f64 * step)).abs() < 1e-9);
+    uniform.then_some((angles[0], step))
+}
+
+/// `connected[i]`: points `i` and `i + 1` are valid and on one surface (no range jump).
+fn connections(
+    ranges: &[f32],
+    angles: &[f64],
+    points: &[[f64; 2]],
+    valid: &[bool],
+    params: &IcpParams,
+) -> Vec<bool> {
+    let n = points.len();
+    let mut connected = vec![false; n];
+    for i in 0..n.saturating_sub(1) {
+        if !(valid[i] && valid[i + 1]) {
+            continue;
+        }
+        let r = f64::from(ranges[i].max(ranges[i + 1]));
+        let gap_allowed = params
+            .discontinuity_min_gap
+            .max(params.discontinuity_gap_factor * r * (angles[i + 1] - angles[i]).abs());
+        let (p, q) = (points[i], points[i + 1]);
+        connected[i] = (q[0] - p[0]).hypot(q[1] - p[1]) <= gap_allowed;
+    }
+    connected
+}
+
+/// The local line of every segment (see the module documentation).
+fn local_lines(
+    points: &[[f64; 2]],
+    connected: &[bool],
+    params: &IcpParams,
+) -> Vec<Option<SegmentLine>> {
+    let n = points.len();
+    let mut segments = vec![None; n];
+    let mut fits: Vec<WindowFit> = Vec::with_capacity(n);
+    let mut start = 0;
+    while start < n {
+        if !connected[start] {
+            start += 1;
+            continue;
+        }
+        // Run of points start..=end, each connected to the next.
+        let mut end = start + 1;
+        while end < n && connected[end] {
+            end += 1;
+        }
+        let run_len = end - start + 1;
+        let w = params.line_fit_window.min(run_len);
+        fits.clear();
+        for s in start..=end + 1 - w {
+            fits.push(fit_window(&points[s..s + w]));
+        }
+        for (i, segment) in segments.iter_mut().enumerate().take(end).skip(start) {
+            // Windows s..s+w containing i and i+1: s in [i + 2 - w, i] within the run.
+            let s_lo = (i + 2).saturating_sub(w).max(start);
+            let s_hi = i.min(end + 1 - w);
+            let best = fits[s_lo - start..=s_hi - start]
+                .iter()
+                .min_by(|a, b| a.rms.total_cmp(&b.rms));
+            if let Some(best) = best {
+                if best.rms <= params.max_line_fit_rms && best.line.normal[0].is_finite() {
+                    *segment = Some(best.line);
+                }
+            }
+        }
+        start = end + 1;
+    }
+    segments
+}
+
+/// Total-least-squares line through `pts` (at least 2 points) and its RMS residual.
+fn fit_window(pts: &[[f64; 2]]) -> WindowFit {
+    // Moments about the first point, to avoid cancellation.
+    let o = pts[0];
+    let k = pts.len() as f64;
+    let (mut sx, mut sy) = (0.0, 0.0);
+    for p in pts {
+        sx += p[0] - o[0];
+        sy += p[1] - o[1];
+    }
+    let (mx, my) = (sx / k, sy / k);
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in pts {
+        let dx = p[0] - o[0] - mx;
+        let dy = p[1] - o[1] - my;
+        sxx += dx * dx;
+        sxy += dx * dy;
+        syy += dy * dy;
+    }
+    // Direction of the major axis of the scatter; the normal is perpendicular to it.
+    let phi = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let (s, c) = phi.sin_cos();
+    let mut normal = [-s, c];
+    let centroid = [o[0] + mx, o[1] + my];
+    let mut offset = normal[0] * centroid[0] + normal[1] * centroid[1];
+    if offset > 0.0 {
+        normal = [-normal[0], -normal[1]];
+        offset = -offset;
+    }
+    let half_trace = 0.5 * (sxx + syy);
+    let half_diff = (0.5 * (sxx - syy)).hypot(sxy);
+    let smallest = (half_trace - half_diff).max(0.0);
+    WindowFit {
+        line: SegmentLine { normal, offset },
+        rms: (smallest / k).sqrt(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fit_window_recovers_an_exact_line() {
+        // Points on x·cos(a) + y·sin(a) = d.
+        let (a, d) = (0.7_f64, 1.3_f64);
+        let n = [a.cos(), a.sin()];
+        let t = [-n[1], n[0]];
+        let pts: Vec<[f64; 2]> = (0..7)
+            .map(|i| {
+                let u = 0.01 * i as f64 - 0.02;
+                [d * n[0] + u * t[0], d * n[1] + u * t[1]]
+            })
+            .collect();
+        let fit = fit_window(&pts);
+        assert!(fit.rms < 1e-12);
+        // Normal towards the sensor: −n, offset −d.
+        assert!((fit.line.normal[0] + n[0]).abs() < 1e-12);
+        assert!((fit.line.normal[1] + n[1]).abs() < 1e-12);
+        assert!((fit.line.offset + d).abs() < 1e-12);
+    }
+
+    #[test]
+    fn invalid_readings_are_marked() {
+        let angles: Vec<f64> = (0..40).map(|i| -0.5 + 0.025 * i as f64).collect();
+        let mut ranges: Vec<f32> = angles.iter().map(|a| (1.0 / a.cos()) as f32).collect();
+        ranges[3] = 0.0;
+        ranges[4] = f32::NAN;
+        ranges[5] = f32::INFINITY;
+        ranges[6] = 5.0;
+        ranges[7] = 0.01;
+        let scan = PreparedScan::new(&ranges, &angles, 0.02, 4.0, &IcpParams::default())
+            .expect("enough valid points");
+        assert_eq!(scan.valid_count(), 35);
+        for i in 3..8 {
+            assert!(scan.point(i).is_none(), "reading {i} must be invalid");
+        }
+        // Segments touching invalid readings are unusable; the wall x = 1 elsewhere.
+        assert!(scan.segments[2].is_none() && scan.segments[7].is_none());
+        let line = scan.segments[20].expect("segment on the wall");
+        assert!((line.normal[0] + 1.0).abs() < 1e-9 && (line.offset + 1.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn range_jumps_split_runs() {
+        let angles: Vec<f64> = (0..40).map(|i| -0.5 + 0.025 * i as f64).collect();
+        let ranges: Vec<f32> = angles
+            .iter()
+            .enumerate()
+            .map(|(i, a)| ((if i < 20 { 1.0 } else { 2.0 }) / a.cos()) as f32)
+            .collect();
+        let scan = PreparedScan::new(&ranges, &angles, 0.02, 4.0, &IcpParams::default())
+            .expect("enough valid points");
+        assert!(scan.segments[19].is_none(), "no segment across the jump");
+        assert!(scan.segments[18].is_some() && scan.segments[20].is_some());
+        let far = scan.segments[25].expect("far wall");
+        assert!((far.offset + 2.0).abs() < 1e-9);
+    }
+}
