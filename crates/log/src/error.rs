@@ -27,6 +27,14 @@ pub enum LogError {
         #[source]
         source: std::io::Error,
     },
+    /// A reader option (usually from the command line) has an impossible value.
+    #[error("invalid {option}: expected {expected}")]
+    InvalidOption {
+        /// Which option.
+        option: &'static str,
+        /// What was expected.
+        expected: &'static str,
+    },
     /// The log parsed but lacks something needed for calibration.
     #[error("{file}: {what}")]
     MissingData {

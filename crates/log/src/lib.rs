@@ -12,13 +12,24 @@
 
 #![deny(missing_docs)]
 
+mod builder;
+mod carmen;
 mod error;
+mod json_log;
 mod json_stream;
 mod model;
+mod number;
+mod options;
+mod read;
+mod tokens;
 mod tuple;
 mod writer;
 
+pub use carmen::read_carmen_from;
 pub use error::{LogError, MissingData};
+pub use json_log::read_json_log_from;
 pub use model::*;
+pub use options::{Mode, ReadOptions};
+pub use read::{detect_format, read_log, LogFormat};
 pub use tuple::{read_tuples, read_tuples_from, write_tuple, TupleRecord};
 pub use writer::{write_log, LogWriter, RobotLaserPoses};

@@ -1,0 +1,483 @@
+//! The streaming reader for Carmen-style text logs (see `docs/log-format.md`).
+//!
+//! One reused line buffer; tokens are byte slices of it; numbers are parsed in place;
+//! readings go straight into the log's packed `f32` store. Nothing else is kept of the
+//! text.
+
+use crate::builder::{LogBuilder, Stream};
+use crate::error::LogError;
+use crate::model::{Log, OdomRecord, ScanGeometry, ScanKind, ValueSource};
+use crate::options::{is_valid_modulus, ReadOptions};
+use crate::tokens::{FieldError, Fields, Tokens};
+use odocal_geom::Pose2;
+use std::io::BufRead;
+
+/// The messages this reader understands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Message {
+    Param,
+    Encoder,
+    RawLaser1,
+    RobotLaser1,
+    FLaser,
+    Odom,
+}
+
+const MESSAGES: [(Message, &str); 6] = [
+    (Message::Param, "PARAM"),
+    (Message::Encoder, "ENCODER"),
+    (Message::RawLaser1, "RAWLASER1"),
+    (Message::RobotLaser1, "ROBOTLASER1"),
+    (Message::FLaser, "FLASER"),
+    (Message::Odom, "ODOM"),
+];
+
+impl Message {
+    fn from_name(name: &[u8]) -> Option<Message> {
+        MESSAGES
+            .iter()
+            .find(|(_, n)| n.as_bytes() == name)
+            .map(|(m, _)| *m)
+    }
+
+    fn name(self) -> &'static str {
+        MESSAGES[self as usize].1
+    }
+
+    /// The fields after the name, for messages with a fixed number of them.
+    fn fixed_fields(self) -> Option<&'static str> {
+        match self {
+            Message::Encoder => Some("left_ticks right_ticks timestamp hostname logger_timestamp"),
+            Message::Odom => Some("x y theta tv rv accel timestamp hostname logger_timestamp"),
+            _ => None,
+        }
+    }
+}
+
+/// The laser geometry fields of a RAWLASER1 / ROBOTLASER1 line.
+struct LaserHeader {
+    laser_type: i32,
+    start_angle: f64,
+    fov: f64,
+    resolution: f64,
+    max_range: f64,
+    accuracy: f64,
+    remission_mode: i32,
+}
+
+/// Parser state across lines.
+struct CarmenReader<'o> {
+    b: LogBuilder<'o>,
+    name: String,
+    counts: [u64; 6],
+    /// Index of the geometry used by the previous scan (most scans share it).
+    last_geometry: Option<u32>,
+    /// Maximum range of FLASER scans (PARAM `laser_front_laser_max_range`).
+    flaser_max_range: f64,
+    /// A RAWLASER1/ROBOTLASER1 field of view disagreed with its resolution already.
+    warned_fov: bool,
+    /// The FLASER field of view PARAM disagreed with the resolution PARAM already.
+    warned_flaser_fov: bool,
+}
+
+/// Reads a Carmen-style log from `reader`; `name` is used in messages.
+pub fn read_carmen_from<R: BufRead>(
+    mut reader: R,
+    name: &str,
+    opts: &ReadOptions,
+) -> Result<Log, LogError> {
+    if let Some((option, expected)) = opts.invalid() {
+        return Err(LogError::InvalidOption { option, expected });
+    }
+    let mut r = CarmenReader {
+        b: LogBuilder::new(name, opts),
+        name: name.to_string(),
+        counts: [0; 6],
+        last_geometry: None,
+        flaser_max_range: f64::INFINITY,
+        warned_fov: false,
+        warned_flaser_fov: false,
+    };
+    let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+    let mut line_no: u64 = 0;
+    loop {
+        buf.clear();
+        let n = reader
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| LogError::io(name, e))?;
+        if n == 0 {
+            break;
+        }
+        line_no += 1;
+        r.line(&buf, line_no)?;
+    }
+    r.b.log.stats.lines = line_no;
+    for (k, (_, msg)) in MESSAGES.iter().enumerate() {
+        if r.counts[k] > 0 {
+            r.b.log.stats.messages.insert(msg.to_string(), r.counts[k]);
+        }
+    }
+    Ok(r.b.finish())
+}
+
+impl CarmenReader<'_> {
+    /// Handles one line (with its `\n`, if any).
+    fn line(&mut self, text: &[u8], line: u64) -> Result<(), LogError> {
+        let mut tokens = Tokens::new(text);
+        let Some(first) = tokens.next() else {
+            self.b.log.stats.blank += 1;
+            return Ok(());
+        };
+        if first[0] == b'#' {
+            self.b.log.stats.comments += 1;
+            return Ok(());
+        }
+        let Some(msg) = Message::from_name(first) else {
+            let unknown = &mut self.b.log.stats.unknown;
+            let name = String::from_utf8_lossy(first);
+            match unknown.get_mut(name.as_ref()) {
+                Some(c) => *c += 1,
+                None => {
+                    unknown.insert(name.into_owned(), 1);
+                }
+            }
+            return Ok(());
+        };
+        let mut f = Fields { tokens };
+        let result = match msg {
+            Message::Param => self.param(&mut f, line),
+            Message::Encoder => self.encoder(&mut f, line),
+            Message::RawLaser1 | Message::RobotLaser1 => self.laser(&mut f, msg, line),
+            Message::FLaser => self.flaser(&mut f, line),
+            Message::Odom => self.odom(&mut f, line),
+        };
+        match result {
+            Ok(()) => {
+                self.counts[msg as usize] += 1;
+                Ok(())
+            }
+            Err(e) => {
+                let expected = match msg.fixed_fields() {
+                    Some(fields) => {
+                        let want = fields.split(' ').count();
+                        let found = Tokens::new(text).count() - 1;
+                        if found == want {
+                            e.describe()
+                        } else {
+                            format!(
+                                "expected {want} fields ({fields}), found {found}: {}",
+                                e.describe()
+                            )
+                        }
+                    }
+                    None => e.describe(),
+                };
+                let err = LogError::parse(&self.name, line, msg.name(), expected);
+                self.b.reject(err)
+            }
+        }
+    }
+
+    /// `timestamp hostname logger_timestamp` and the end of the line.
+    fn trailer(f: &mut Fields<'_>) -> Result<f64, FieldError> {
+        let t = f.finite_f64("timestamp")?;
+        f.token("hostname")?;
+        f.f64("logger_timestamp")?;
+        f.end("logger_timestamp")?;
+        Ok(t)
+    }
+
+    fn param(&mut self, f: &mut Fields<'_>, line: u64) -> Result<(), FieldError> {
+        let name = f.token("parameter name")?;
+        let value_token = f.token("parameter value")?;
+        let value = || crate::number::parse_f64(value_token);
+        let bad = |what: &str| FieldError::new(what, Some(value_token));
+        let params = &mut self.b.log.params;
+        match name {
+            b"robot_wheel_ticks_per_revolution" => {
+                let v = value()
+                    .filter(|v| v.is_finite() && *v > 0.0)
+                    .ok_or_else(|| bad("ticks per revolution (a positive number)"))?;
+                params.ticks_per_revolution = Some((v, ValueSource::LogParam { line }));
+            }
+            b"robot_encoder_modulus" => {
+                let v = value()
+                    .filter(|v| is_valid_modulus(*v))
+                    .ok_or_else(|| bad("encoder modulus (an integer between 2 and 2^62)"))?;
+                params.encoder_modulus = Some(v);
+            }
+            b"laser_front_laser_min_range" => {
+                let v = value()
+                    .filter(|v| v.is_finite() && *v >= 0.0)
+                    .ok_or_else(|| bad("minimum range (a finite number ≥ 0, m)"))?;
+                params.laser_min_range = v;
+            }
+            b"laser_front_laser_fov" => {
+                let v = value()
+                    .filter(|v| v.is_finite() && *v > 0.0)
+                    .ok_or_else(|| bad("field of view (a positive number, rad)"))?;
+                params.flaser_fov = Some(v);
+            }
+            b"laser_front_laser_resolution" => {
+                let v = value()
+                    .filter(|v| v.is_finite() && *v > 0.0)
+                    .ok_or_else(|| bad("angular resolution (a positive number, rad)"))?;
+                params.flaser_resolution = Some(v);
+            }
+            b"laser_front_laser_max_range" => {
+                let v = value()
+                    .filter(|v| *v > 0.0)
+                    .ok_or_else(|| bad("maximum range (a positive number, m)"))?;
+                self.flaser_max_range = v;
+            }
+            _ => {}
+        }
+        let params = &mut self.b.log.params;
+        let name = String::from_utf8_lossy(name).into_owned();
+        let value = String::from_utf8_lossy(value_token).into_owned();
+        params.all.insert(name, value);
+        Ok(())
+    }
+
+    fn encoder(&mut self, f: &mut Fields<'_>, line: u64) -> Result<(), FieldError> {
+        let left = f.i64("left_ticks")?;
+        let right = f.i64("right_ticks")?;
+        let t = Self::trailer(f)?;
+        self.b
+            .add_encoder(t, left, right, line)
+            .map_err(|e| FieldError::new(e, None))
+    }
+
+    fn odom(&mut self, f: &mut Fields<'_>, line: u64) -> Result<(), FieldError> {
+        let x = f.f64("x")?;
+        let y = f.f64("y")?;
+        let theta = f.f64("theta")?;
+        let tv = f.f64("tv")?;
+        let rv = f.f64("rv")?;
+        let accel = f.f64("accel")?;
+        let t = Self::trailer(f)?;
+        self.b.add_odom(OdomRecord {
+            t,
+            pose: Pose2 { x, y, theta },
+            tv,
+            rv,
+            accel,
+            line,
+        });
+        Ok(())
+    }
+
+    /// RAWLASER1 and ROBOTLASER1.
+    fn laser(&mut self, f: &mut Fields<'_>, msg: Message, line: u64) -> Result<(), FieldError> {
+        let h = LaserHeader {
+            laser_type: f.i32("laser_type")?,
+            start_angle: f.finite_f64("start_angle")?,
+            fov: f.finite_f64("field_of_view")?,
+            resolution: f.finite_f64("angular_resolution")?,
+            max_range: f.f64("maximum_range").and_then(|v| {
+                if v.is_nan() {
+                    Err(FieldError::new("maximum_range (a number)", Some(b"nan")))
+                } else {
+                    Ok(v)
+                }
+            })?,
+            accuracy: f.f64("accuracy")?,
+            remission_mode: f.i32("remission_mode")?,
+        };
+        let n = f.count("num_readings")?;
+        let store = &mut self.b.log.scans;
+        let (r0, m0) = (store.ranges.len(), store.remissions.len());
+        let body = Self::laser_body(f, msg, n, &mut store.ranges, &mut store.remissions);
+        let t = match body {
+            Ok(t) => t,
+            Err(e) => {
+                store.ranges.truncate(r0);
+                store.remissions.truncate(m0);
+                return Err(e);
+            }
+        };
+        let k = store.remissions.len() - m0;
+        let n_f = n.saturating_sub(1) as f64;
+        if !self.warned_fov && (h.fov - n_f * h.resolution).abs() > 1e-6 + 1e-4 * h.fov.abs() {
+            self.warned_fov = true;
+            self.b.warn(format!(
+                "{}: line {line}: {} field_of_view {} disagrees with (num_readings − 1) · \
+                 angular_resolution = {}; the resolution is used (warned once)",
+                self.name,
+                msg.name(),
+                h.fov,
+                n_f * h.resolution
+            ));
+        }
+        let kind = if msg == Message::RawLaser1 {
+            ScanKind::RawLaser1
+        } else {
+            ScanKind::RobotLaser1
+        };
+        let g = self.geometry_for(&h, n);
+        self.b.check_order(Stream::Scan, t, line);
+        self.b.log.scans.push_meta(t, g, n, k, kind, line);
+        Ok(())
+    }
+
+    /// Readings, remissions, (ROBOTLASER1 poses,) trailer. Returns the timestamp.
+    fn laser_body(
+        f: &mut Fields<'_>,
+        msg: Message,
+        n: usize,
+        ranges: &mut Vec<f32>,
+        remissions: &mut Vec<f32>,
+    ) -> Result<f64, FieldError> {
+        let explain = |e: FieldError, f: &Fields<'_>| FieldError {
+            expected: format!(
+                "{} (num_readings = {n}; {} token(s) left on the line)",
+                e.expected,
+                f.tokens.count_remaining()
+            ),
+            found: e.found,
+        };
+        for _ in 0..n {
+            match f.f32("range reading") {
+                Ok(r) => ranges.push(r),
+                Err(e) => return Err(explain(e, f)),
+            }
+        }
+        let k = f.count("num_remissions").map_err(|e| explain(e, f))?;
+        for _ in 0..k {
+            remissions.push(f.f32("remission").map_err(|e| explain(e, f))?);
+        }
+        if msg == Message::RobotLaser1 {
+            for what in [
+                "laser_pose_x",
+                "laser_pose_y",
+                "laser_pose_theta",
+                "robot_pose_x",
+                "robot_pose_y",
+                "robot_pose_theta",
+                "laser_tv",
+                "laser_rv",
+                "forward_safety_dist",
+                "side_safety_dist",
+                "turn_axis",
+            ] {
+                f.f64(what).map_err(|e| explain(e, f))?;
+            }
+        }
+        Self::trailer(f).map_err(|e| explain(e, f))
+    }
+
+    /// The index of the geometry described by `h` with `n` rays, reusing a stored one.
+    fn geometry_for(&mut self, h: &LaserHeader, n: usize) -> u32 {
+        let min_range = self
+            .b
+            .opts
+            .min_range
+            .unwrap_or(self.b.log.params.laser_min_range);
+        let fits = |g: &ScanGeometry| {
+            g.has_fields(
+                h.laser_type,
+                h.start_angle,
+                h.fov,
+                h.resolution,
+                h.max_range,
+                min_range,
+                h.accuracy,
+                h.remission_mode,
+                n,
+            )
+        };
+        let store = &mut self.b.log.scans;
+        if let Some(i) = self.last_geometry {
+            if fits(&store.geometries[i as usize]) {
+                return i;
+            }
+        }
+        let i = match store.geometries.iter().position(fits) {
+            Some(i) => i as u32,
+            None => {
+                store.geometries.push(ScanGeometry::new(
+                    h.laser_type,
+                    h.start_angle,
+                    h.fov,
+                    h.resolution,
+                    h.max_range,
+                    min_range,
+                    h.accuracy,
+                    h.remission_mode,
+                    n,
+                ));
+                (store.geometries.len() - 1) as u32
+            }
+        };
+        self.last_geometry = Some(i);
+        i
+    }
+
+    fn flaser(&mut self, f: &mut Fields<'_>, line: u64) -> Result<(), FieldError> {
+        let n = f.count("num_readings")?;
+        let store = &mut self.b.log.scans;
+        let r0 = store.ranges.len();
+        let body = (|| {
+            for _ in 0..n {
+                store.ranges.push(f.f32("range reading")?);
+            }
+            for what in ["x", "y", "theta", "odom_x", "odom_y", "odom_theta"] {
+                f.f64(what)?;
+            }
+            Self::trailer(f)
+        })();
+        let t = match body {
+            Ok(t) => t,
+            Err(e) => {
+                store.ranges.truncate(r0);
+                return Err(FieldError {
+                    expected: format!(
+                        "{} (num_readings = {n}; {} token(s) left on the line)",
+                        e.expected,
+                        f.tokens.count_remaining()
+                    ),
+                    found: e.found,
+                });
+            }
+        };
+        let params = &self.b.log.params;
+        let fov = params.flaser_fov.unwrap_or(std::f64::consts::PI);
+        let n_f = n.saturating_sub(1) as f64;
+        let resolution = match params.flaser_resolution {
+            Some(res) => {
+                if !self.warned_flaser_fov
+                    && params.flaser_fov.is_some()
+                    && (fov - n_f * res).abs() > 1e-6 + 1e-4 * fov
+                {
+                    self.warned_flaser_fov = true;
+                    self.b.warn(format!(
+                        "{}: line {line}: FLASER field of view {fov} (PARAM) disagrees with \
+                         (num_readings − 1) · resolution = {}; the resolution is used \
+                         (warned once)",
+                        self.name,
+                        n_f * res
+                    ));
+                }
+                res
+            }
+            None if n > 1 => fov / n_f,
+            None => 0.0,
+        };
+        let h = LaserHeader {
+            laser_type: 0,
+            start_angle: -0.5 * n_f * resolution,
+            fov: n_f * resolution,
+            resolution,
+            max_range: self.flaser_max_range,
+            accuracy: 0.0,
+            remission_mode: 0,
+        };
+        let g = self.geometry_for(&h, n);
+        self.b.check_order(Stream::Scan, t, line);
+        self.b
+            .log
+            .scans
+            .push_meta(t, g, n, 0, ScanKind::FLaser, line);
+        Ok(())
+    }
+}

@@ -1,0 +1,164 @@
+//! Splitting a log line into tokens and reading typed fields from them, without
+//! allocating unless there is an error to report.
+
+use crate::number::{parse_f32, parse_f64, parse_i64};
+
+/// True for the bytes that separate tokens: space, tab, the line end, form feeds.
+#[inline]
+fn is_separator(b: u8) -> bool {
+    matches!(b, b' ' | b'\t' | b'\n' | b'\r' | 0x0b | 0x0c)
+}
+
+/// The whitespace-separated tokens of one line.
+#[derive(Clone)]
+pub(crate) struct Tokens<'a> {
+    s: &'a [u8],
+    i: usize,
+}
+
+impl<'a> Tokens<'a> {
+    pub(crate) fn new(s: &'a [u8]) -> Self {
+        Tokens { s, i: 0 }
+    }
+
+    /// How many tokens are left (used only to explain an error).
+    pub(crate) fn count_remaining(&self) -> usize {
+        self.clone().count()
+    }
+}
+
+impl<'a> Iterator for Tokens<'a> {
+    type Item = &'a [u8];
+
+    #[inline]
+    fn next(&mut self) -> Option<&'a [u8]> {
+        let s = self.s;
+        let mut i = self.i;
+        while i < s.len() && is_separator(s[i]) {
+            i += 1;
+        }
+        if i == s.len() {
+            self.i = i;
+            return None;
+        }
+        let start = i;
+        while i < s.len() && !is_separator(s[i]) {
+            i += 1;
+        }
+        self.i = i;
+        Some(&s[start..i])
+    }
+}
+
+/// A field that could not be read: what was expected and what was there.
+#[derive(Debug)]
+pub(crate) struct FieldError {
+    pub(crate) expected: String,
+    pub(crate) found: Option<String>,
+}
+
+impl FieldError {
+    pub(crate) fn new(expected: impl Into<String>, found: Option<&[u8]>) -> Self {
+        FieldError {
+            expected: expected.into(),
+            found: found.map(|t| {
+                let t = String::from_utf8_lossy(t);
+                if t.chars().count() > 40 {
+                    format!("`{}…`", t.chars().take(40).collect::<String>())
+                } else {
+                    format!("`{t}`")
+                }
+            }),
+        }
+    }
+
+    /// "expected X, found Y".
+    pub(crate) fn describe(&self) -> String {
+        match &self.found {
+            Some(f) => format!("expected {}, found {f}", self.expected),
+            None => format!("expected {}, found end of line", self.expected),
+        }
+    }
+}
+
+/// Typed reads from a token stream; each names the field it expects for the error.
+pub(crate) struct Fields<'a> {
+    pub(crate) tokens: Tokens<'a>,
+}
+
+impl<'a> Fields<'a> {
+    /// The next token, whatever it is.
+    #[inline]
+    pub(crate) fn token(&mut self, what: &str) -> Result<&'a [u8], FieldError> {
+        self.tokens
+            .next()
+            .ok_or_else(|| FieldError::new(what, None))
+    }
+
+    /// A float (any value, `inf` and `nan` included).
+    #[inline]
+    pub(crate) fn f64(&mut self, what: &str) -> Result<f64, FieldError> {
+        let t = self.tokens.next();
+        t.and_then(parse_f64)
+            .ok_or_else(|| FieldError::new(format!("{what} (a number)"), t))
+    }
+
+    /// A finite float.
+    #[inline]
+    pub(crate) fn finite_f64(&mut self, what: &str) -> Result<f64, FieldError> {
+        let t = self.tokens.next();
+        t.and_then(parse_f64)
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| FieldError::new(format!("{what} (a finite number)"), t))
+    }
+
+    /// A float stored as `f32` (a range reading; any value).
+    #[inline]
+    pub(crate) fn f32(&mut self, what: &str) -> Result<f32, FieldError> {
+        let t = self.tokens.next();
+        t.and_then(parse_f32)
+            .ok_or_else(|| FieldError::new(format!("{what} (a number)"), t))
+    }
+
+    /// A signed integer; an integral float such as `12.0` is accepted too.
+    #[inline]
+    pub(crate) fn i64(&mut self, what: &str) -> Result<i64, FieldError> {
+        let t = self.tokens.next();
+        t.and_then(|t| {
+            parse_i64(t).or_else(|| {
+                parse_f64(t)
+                    .filter(|v| v.fract() == 0.0 && v.abs() < 9.0e15)
+                    .map(|v| v as i64)
+            })
+        })
+        .ok_or_else(|| FieldError::new(format!("{what} (an integer)"), t))
+    }
+
+    /// A 32-bit signed integer.
+    #[inline]
+    pub(crate) fn i32(&mut self, what: &str) -> Result<i32, FieldError> {
+        let t = self.tokens.clone().next();
+        let v = self.i64(what)?;
+        i32::try_from(v).map_err(|_| FieldError::new(format!("{what} (a 32-bit integer)"), t))
+    }
+
+    /// A count (non-negative integer).
+    #[inline]
+    pub(crate) fn count(&mut self, what: &str) -> Result<usize, FieldError> {
+        let t = self.tokens.clone().next();
+        let v = self.i64(what)?;
+        usize::try_from(v).map_err(|_| FieldError::new(format!("{what} (a count ≥ 0)"), t))
+    }
+
+    /// Nothing more on the line.
+    #[inline]
+    pub(crate) fn end(&mut self, after: &str) -> Result<(), FieldError> {
+        match self.tokens.next() {
+            None => Ok(()),
+            Some(t) => Err(FieldError::new(
+                format!("end of line after {after}"),
+                Some(t),
+            )),
+        }
+    }
+}
