@@ -1,1 +1,52 @@
-//! placeholder, being written
+//! Simultaneous calibration of a differential-drive robot's odometry (wheel radii
+//! `r_L`, `r_R`, wheel distance `b`) and of its sensor's pose `ℓ = (ℓx, ℓy, ℓθ)`
+//! from samples: wheel rotations over an interval and the sensor displacement `ŝ`
+//! that scan matching estimated over the same interval.
+//!
+//! The method is Censi, Marchionni, Oriolo (ICRA 2008) and Censi, Franchi,
+//! Marchionni, Oriolo (T-RO 2013), following `docs/method.md` (the papers' math with
+//! the misprints corrected):
+//!
+//! 1. [`step1`]: `J21`, `J22` by linear least squares on the heading changes;
+//! 2. [`step2`]: `b` and `ℓ` from `ℓ ⊕ ŝ = o ⊕ ℓ` via the Schur complement of the
+//!    constrained quadratic problem (integrating the kinematics over wheel-speed
+//!    profiles when samples carry them);
+//! 3. [`trimming`]: outlier removal, ICRA or T-RO rule, re-solving each round;
+//! 4. [`refine`]: maximum-likelihood refinement (Levenberg–Marquardt on `ŝ_pred − ŝ`);
+//! 5. covariance (inverse Fisher information with analytic Jacobians) and an
+//!    [`Observability`] report; degenerate data give [`SolveError::NotExcited`].
+//!
+//! Entry point: [`calibrate`].
+
+#![deny(missing_docs)]
+// Dense 2×2 … 6×6 numerics read best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
+mod calibrate;
+mod covariance;
+mod error;
+mod kinematics;
+mod linalg;
+mod noise;
+mod normal_equations;
+mod observability;
+mod params;
+pub mod refine;
+mod sample;
+pub mod step1;
+pub mod step2;
+pub mod trimming;
+
+pub use calibrate::{
+    calibrate, closed_form, Calibration, ClosedForm, NoiseSource, SolveOptions, MIN_SAMPLES,
+    STEP1_SINGULAR_CONDITION,
+};
+pub use covariance::INFORMATION_SINGULAR_RATIO;
+pub use error::SolveError;
+pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
+pub use noise::{residual_sigmas, SIGMA_FLOOR};
+pub use observability::{MotionContent, Observability, ParameterReport, Verdict};
+pub use params::{Params, PARAMETER_NAMES};
+pub use refine::Refinement;
+pub use sample::{ProfileSegment, Sample};
+pub use trimming::Trim;

@@ -1,0 +1,297 @@
+//! The whole chain: checks, closed form (step 1 + step 2) with outlier trimming,
+//! noise estimate, maximum-likelihood refinement, covariance, observability.
+
+use crate::covariance::{invert_information, Inversion};
+use crate::error::SolveError;
+use crate::kinematics::Predictor;
+use crate::noise::{residual_sigmas, NoiseWeights};
+use crate::normal_equations::{accumulate, cost};
+use crate::observability::{
+    information_not_excited, null_direction_names, parameter_reports, sentence, step1_not_excited,
+    step2_not_excited, wheel_signs, MotionContent, Observability, Verdict,
+};
+use crate::params::Params;
+use crate::refine::{refine, Refinement};
+use crate::sample::Sample;
+use crate::step1::{step1, Step1};
+use crate::step2::{build_m, solve_m, Step2, A_SINGULAR_CONDITION};
+use crate::trimming::Trim;
+use odocal_geom::wrap_angle;
+use serde::{Deserialize, Serialize};
+
+/// Fewest samples the solver accepts (input and after each trimming round).
+pub const MIN_SAMPLES: usize = 10;
+
+/// Condition number of step 1's normal matrix above which `J21`, `J22` are
+/// numerically undetermined (an error, not a warning; below it the covariance
+/// decides).
+pub const STEP1_SINGULAR_CONDITION: f64 = 1e12;
+
+/// Settings of [`calibrate`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SolveOptions {
+    /// Outlier trimming between closed-form solves (default: the original
+    /// package's rule, [`Trim::TRO`]).
+    pub trim: Trim,
+    /// Refine all six parameters by maximum likelihood (default true).
+    pub refine: bool,
+    /// Use the wheel-speed profile of samples that have one (default true).
+    pub use_profile: bool,
+    /// Weight step 1 by 1/σθ² when every sample has a covariance (default true).
+    pub weighted_step1: bool,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        SolveOptions {
+            trim: Trim::TRO,
+            refine: true,
+            use_profile: true,
+            weighted_step1: true,
+        }
+    }
+}
+
+/// Where the weights of the residuals (and the covariance's noise level) came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum NoiseSource {
+    /// Standard deviations estimated from the closed form's residuals.
+    Estimated,
+    /// Each sample's own `sm_cov`.
+    SampleCovariance,
+}
+
+/// The closed-form solution on one set of samples.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ClosedForm {
+    /// The parameters.
+    pub params: Params,
+    /// Step 1.
+    pub step1: Step1,
+    /// Step 2.
+    pub step2: Step2,
+}
+
+/// Everything [`calibrate`] finds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Calibration {
+    /// The estimate (refined unless refinement was switched off).
+    pub params: Params,
+    /// The closed-form estimate after trimming (before refinement).
+    pub closed_form: Params,
+    /// `J = [[r_L/2, r_R/2], [−r_L/b, r_R/b]]` of the estimate.
+    pub j: [[f64; 2]; 2],
+    /// Covariance of (r_L, r_R, b, ℓx, ℓy, ℓθ) at the estimate.
+    pub covariance: [[f64; 6]; 6],
+    /// Standard deviations (x, y, θ) of `ŝ_pred − ŝ` at the first (untrimmed)
+    /// closed-form estimate over the samples kept after the first trimming round
+    /// (m, m, rad), as the original package estimates the scan-matching noise.
+    pub sm_sigma: [f64; 3],
+    /// Source of the residual weights used by the refinement and the covariance.
+    pub noise_source: NoiseSource,
+    /// Number of samples used by the final estimate.
+    pub samples_used: usize,
+    /// Per input sample: whether it survived trimming.
+    pub used: Vec<bool>,
+    /// Number of samples after each trimming round (first entry: the input).
+    pub samples_per_round: Vec<usize>,
+    /// Weighted cost `Σ (ŝ_pred − ŝ)ᵀ Σ⁻¹ (ŝ_pred − ŝ)` at the closed form.
+    pub cost_before: f64,
+    /// The same cost at the returned estimate.
+    pub cost_after: f64,
+    /// Details of the refinement, when it ran.
+    pub refinement: Option<Refinement>,
+    /// Observability report.
+    pub observability: Observability,
+}
+
+/// Closed form (step 1 and step 2) on `active`, or the "not excited" error.
+pub fn closed_form(
+    samples: &[Sample],
+    active: &[usize],
+    theta_weights: Option<&[f64]>,
+    use_profile: bool,
+) -> Result<(ClosedForm, Vec<[f64; 3]>), SolveError> {
+    let s1 = step1(samples, active, theta_weights);
+    if s1.condition.is_nan()
+        || s1.condition > STEP1_SINGULAR_CONDITION
+        || !s1.j21.is_finite()
+        || !s1.j22.is_finite()
+    {
+        return Err(step1_not_excited(samples, active, &s1));
+    }
+    let (m, unit) = build_m(samples, active, s1.j21, s1.j22, use_profile);
+    let s2 = match solve_m(&m) {
+        Some(s2) if s2.a_condition_scaled <= A_SINGULAR_CONDITION && s2.b > 0.0 => s2,
+        Some(s2) => {
+            return Err(step2_not_excited(
+                samples,
+                active,
+                &s1,
+                Some(s2.a_weakest_direction),
+            ))
+        }
+        None => return Err(step2_not_excited(samples, active, &s1, None)),
+    };
+    let params = Params {
+        r_l: -s2.b * s1.j21,
+        r_r: s2.b * s1.j22,
+        b: s2.b,
+        laser: s2.laser,
+    };
+    // Residuals ŝ_pred − ŝ from the cached unit odometry: o = (b·c_x, b·c_y, oθ).
+    let pred = Predictor::new(&params, use_profile);
+    let residuals = active
+        .iter()
+        .zip(&unit)
+        .map(|(&k, u)| {
+            let p = pred.sensor_from_odometry([s2.b * u[0], s2.b * u[1], u[2]]);
+            let s = &samples[k].sm;
+            [p[0] - s.x, p[1] - s.y, wrap_angle(p[2] - s.theta)]
+        })
+        .collect();
+    Ok((
+        ClosedForm {
+            params,
+            step1: s1,
+            step2: s2,
+        },
+        residuals,
+    ))
+}
+
+/// Calibrates: the six parameters, their covariance and the observability report.
+pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibration, SolveError> {
+    for (k, s) in samples.iter().enumerate() {
+        s.check(k)?;
+    }
+    if samples.len() < MIN_SAMPLES {
+        return Err(SolveError::TooFewSamples {
+            got: samples.len(),
+            needed: MIN_SAMPLES,
+            stage: "input".into(),
+        });
+    }
+    let sample_weights = NoiseWeights::from_samples(samples);
+    let theta_weights: Option<Vec<f64>> = match (&sample_weights, options.weighted_step1) {
+        (Some(_), true) => Some(
+            samples
+                .iter()
+                .map(|s| s.sm_cov.map_or(1.0, |c| 1.0 / c[2][2]))
+                .collect(),
+        ),
+        _ => None,
+    };
+    let tw = theta_weights.as_deref();
+
+    let mut active: Vec<usize> = (0..samples.len()).collect();
+    let mut samples_per_round = vec![active.len()];
+    let (mut cf, mut residuals) = closed_form(samples, &active, tw, options.use_profile)?;
+    let mut first_round: Option<Vec<usize>> = None;
+    let untrimmed = cf.params;
+    for round in 0..options.trim.rounds() {
+        let keep = options.trim.keep(&residuals);
+        active = active
+            .iter()
+            .zip(&keep)
+            .filter(|(_, &k)| k)
+            .map(|(&i, _)| i)
+            .collect();
+        samples_per_round.push(active.len());
+        if active.len() < MIN_SAMPLES {
+            return Err(SolveError::TooFewSamples {
+                got: active.len(),
+                needed: MIN_SAMPLES,
+                stage: format!("after trimming round {}", round + 1),
+            });
+        }
+        if first_round.is_none() {
+            first_round = Some(active.clone());
+        }
+        (cf, residuals) = closed_form(samples, &active, tw, options.use_profile)?;
+    }
+
+    // Scan-matching noise as the original package estimates it: residuals of the
+    // first (untrimmed) closed-form estimate over the samples kept after the first
+    // trimming round.
+    let noise_set = first_round.as_deref().unwrap_or(&active);
+    let pred = Predictor::new(&untrimmed, options.use_profile);
+    let noise_residuals: Vec<[f64; 3]> = noise_set
+        .iter()
+        .map(|&k| pred.residual(&samples[k]))
+        .collect();
+    let sm_sigma = residual_sigmas(&noise_residuals);
+
+    let (weights, noise_source) = match sample_weights {
+        Some(w) => (w, NoiseSource::SampleCovariance),
+        None => (NoiseWeights::from_sigmas(sm_sigma), NoiseSource::Estimated),
+    };
+
+    let (params, refinement, cost_before, cost_after) = if options.refine {
+        let r = refine(samples, &active, &cf.params, &weights, options.use_profile);
+        (r.params, Some(r), r.cost_before, r.cost_after)
+    } else {
+        let c = cost(samples, &active, &cf.params, &weights, options.use_profile);
+        (cf.params, None, c, c)
+    };
+    if !params.to_vector().iter().all(|v| v.is_finite()) {
+        return Err(SolveError::Numerical(format!(
+            "the estimate is not finite ({params:?})"
+        )));
+    }
+
+    let r_scale = if params.r_l.abs() + params.r_r.abs() > 0.0 {
+        (params.r_l, params.r_r)
+    } else {
+        (1.0, 1.0)
+    };
+    let motion = MotionContent::classify(samples, &active, r_scale.0, r_scale.1);
+    let information = accumulate(samples, &active, &params, &weights, options.use_profile).h;
+    let covariance = match invert_information(&information) {
+        Inversion::Covariance(c) => *c,
+        Inversion::Singular(null) => {
+            return Err(information_not_excited(
+                null_direction_names(&null),
+                &motion,
+            ))
+        }
+    };
+    let reports = parameter_reports(&params, &covariance);
+    let not_excited: Vec<String> = reports
+        .iter()
+        .filter(|r| r.verdict == Verdict::NotExcited)
+        .map(|r| r.name.clone())
+        .collect();
+    if !not_excited.is_empty() {
+        return Err(information_not_excited(not_excited, &motion));
+    }
+    let observability = Observability {
+        step1_condition: cf.step1.condition,
+        a_condition: cf.step2.a_condition,
+        a_condition_scaled: cf.step2.a_condition_scaled,
+        sentence: sentence(&reports, &motion),
+        parameters: reports,
+        motion,
+        wheel_signs: wheel_signs(&params),
+    };
+    let mut used = vec![false; samples.len()];
+    for &k in &active {
+        used[k] = true;
+    }
+    Ok(Calibration {
+        j: params.j(),
+        params,
+        closed_form: cf.params,
+        covariance,
+        sm_sigma,
+        noise_source,
+        samples_used: active.len(),
+        used,
+        samples_per_round,
+        cost_before,
+        cost_after,
+        refinement,
+        observability,
+    })
+}

@@ -1,0 +1,75 @@
+//! The scan-matching noise model: how residuals `ŝ_pred − ŝ` are weighted, either
+//! by standard deviations estimated from the residuals or by each sample's own
+//! covariance.
+
+use crate::linalg::information_from_covariance;
+use crate::sample::Sample;
+
+/// Smallest standard deviation used for weighting (m or rad); residuals of
+/// noise-free data would otherwise give infinite weights.
+pub const SIGMA_FLOOR: f64 = 1e-12;
+
+/// Weights of the residuals: the information matrix (inverse covariance) of `ŝ`.
+#[derive(Debug, Clone)]
+pub(crate) enum NoiseWeights {
+    /// The same diagonal information `1/σ²` (x, y, θ) for every sample.
+    Shared([f64; 3]),
+    /// Each sample's own information matrix, indexed like the samples.
+    PerSample(Vec<[[f64; 3]; 3]>),
+}
+
+impl NoiseWeights {
+    /// Weights from standard deviations (floored at [`SIGMA_FLOOR`]).
+    pub(crate) fn from_sigmas(sigma: [f64; 3]) -> Self {
+        NoiseWeights::Shared(sigma.map(|s| 1.0 / s.max(SIGMA_FLOOR).powi(2)))
+    }
+
+    /// Each sample's own covariance, when every sample has one; `None` otherwise.
+    /// The covariances must already have been checked (positive definite).
+    pub(crate) fn from_samples(samples: &[Sample]) -> Option<Self> {
+        samples
+            .iter()
+            .map(|s| s.sm_cov.as_ref().and_then(information_from_covariance))
+            .collect::<Option<Vec<_>>>()
+            .map(NoiseWeights::PerSample)
+    }
+
+    /// The information matrix of sample `k`.
+    #[inline]
+    pub(crate) fn information(&self, k: usize) -> [[f64; 3]; 3] {
+        match self {
+            NoiseWeights::Shared(w) => [[w[0], 0.0, 0.0], [0.0, w[1], 0.0], [0.0, 0.0, w[2]]],
+            NoiseWeights::PerSample(v) => v[k],
+        }
+    }
+}
+
+/// Standard deviations (x, y, θ) of the residuals, mean removed, divided by `n − 1`
+/// (zero for fewer than two residuals).
+pub fn residual_sigmas(residuals: &[[f64; 3]]) -> [f64; 3] {
+    let n = residuals.len();
+    if n < 2 {
+        return [0.0; 3];
+    }
+    let mut out = [0.0; 3];
+    for (c, o) in out.iter_mut().enumerate() {
+        let mean = residuals.iter().map(|e| e[c]).sum::<f64>() / n as f64;
+        let ss: f64 = residuals.iter().map(|e| (e[c] - mean).powi(2)).sum();
+        *o = (ss / (n - 1) as f64).sqrt();
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sigmas_of_known_sets() {
+        let r = [[1.0, 0.0, 2.0], [3.0, 0.0, 2.0], [5.0, 0.0, 2.0]];
+        let s = residual_sigmas(&r);
+        assert!((s[0] - 2.0).abs() < 1e-15);
+        assert_eq!(s[1], 0.0);
+        assert_eq!(s[2], 0.0);
+    }
+}

@@ -1,0 +1,105 @@
+//! One pass over the samples: the weighted cost `Σ eᵀWe`, the Gauss–Newton matrix
+//! `Σ GᵀWG` (the Fisher information) and the vector `Σ GᵀWe`, with `e = ŝ_pred − ŝ`
+//! and `G = ∂ŝ_pred/∂(r_L, r_R, b, ℓx, ℓy, ℓθ)`.
+
+use crate::kinematics::Predictor;
+use crate::noise::NoiseWeights;
+use crate::params::Params;
+use crate::sample::Sample;
+use odocal_geom::wrap_angle;
+
+/// Sums over one pass.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct NormalEquations {
+    /// `Σ eᵀWe`.
+    pub cost: f64,
+    /// `Σ GᵀWG` (symmetric).
+    pub h: [[f64; 6]; 6],
+    /// `Σ GᵀWe`.
+    pub g: [f64; 6],
+}
+
+/// Accumulates the normal equations over `active` at `params`.
+pub(crate) fn accumulate(
+    samples: &[Sample],
+    active: &[usize],
+    params: &Params,
+    weights: &NoiseWeights,
+    use_profile: bool,
+) -> NormalEquations {
+    let pred = Predictor::new(params, use_profile);
+    let mut h = [[0.0; 6]; 6];
+    let mut g = [0.0; 6];
+    let mut cost = 0.0;
+    for &k in active {
+        let s = &samples[k];
+        let (p, jac) = pred.predict_with_jacobian(s);
+        let e = [p[0] - s.sm.x, p[1] - s.sm.y, wrap_angle(p[2] - s.sm.theta)];
+        match weights {
+            NoiseWeights::Shared(w) => {
+                for r in 0..3 {
+                    let we = w[r] * e[r];
+                    cost += we * e[r];
+                    for i in 0..6 {
+                        let wg = w[r] * jac[r][i];
+                        g[i] += jac[r][i] * we;
+                        for j in i..6 {
+                            h[i][j] += wg * jac[r][j];
+                        }
+                    }
+                }
+            }
+            NoiseWeights::PerSample(info) => {
+                let w = &info[k];
+                // WG (3×6) and We (3).
+                let mut wg = [[0.0; 6]; 3];
+                let mut we = [0.0; 3];
+                for r in 0..3 {
+                    for c in 0..3 {
+                        we[r] += w[r][c] * e[c];
+                        for i in 0..6 {
+                            wg[r][i] += w[r][c] * jac[c][i];
+                        }
+                    }
+                }
+                for r in 0..3 {
+                    cost += e[r] * we[r];
+                    for i in 0..6 {
+                        g[i] += jac[r][i] * we[r];
+                        for j in i..6 {
+                            h[i][j] += jac[r][i] * wg[r][j];
+                        }
+                    }
+                }
+            }
+        }
+    }
+    for i in 0..6 {
+        for j in 0..i {
+            h[i][j] = h[j][i];
+        }
+    }
+    NormalEquations { cost, h, g }
+}
+
+/// The weighted cost `Σ eᵀWe` alone.
+pub(crate) fn cost(
+    samples: &[Sample],
+    active: &[usize],
+    params: &Params,
+    weights: &NoiseWeights,
+    use_profile: bool,
+) -> f64 {
+    let pred = Predictor::new(params, use_profile);
+    let mut total = 0.0;
+    for &k in active {
+        let e = pred.residual(&samples[k]);
+        let w = weights.information(k);
+        for r in 0..3 {
+            for c in 0..3 {
+                total += e[r] * w[r][c] * e[c];
+            }
+        }
+    }
+    total
+}

@@ -1,0 +1,103 @@
+//! Maximum-likelihood refinement of all six parameters: Levenberg–Marquardt on the
+//! weighted residuals `ŝ_pred − ŝ`, started from the closed form.
+
+use crate::linalg::unit_diagonal;
+use crate::noise::NoiseWeights;
+use crate::normal_equations::accumulate;
+use crate::params::Params;
+use crate::sample::Sample;
+use nalgebra::{SMatrix, SVector};
+use serde::Serialize;
+
+/// Largest number of Levenberg–Marquardt iterations.
+pub const MAX_ITERATIONS: usize = 100;
+
+/// Relative decrease of the cost below which the iteration stops.
+const RELATIVE_TOLERANCE: f64 = 1e-12;
+
+/// Outcome of the refinement.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Refinement {
+    /// The refined parameters.
+    pub params: Params,
+    /// Weighted cost `Σ eᵀWe` at the starting point.
+    pub cost_before: f64,
+    /// Weighted cost at the refined parameters.
+    pub cost_after: f64,
+    /// Iterations taken.
+    pub iterations: usize,
+    /// Whether the cost stopped decreasing before the iteration limit.
+    pub converged: bool,
+}
+
+/// Refines `start` over the samples `active`.
+pub(crate) fn refine(
+    samples: &[Sample],
+    active: &[usize],
+    start: &Params,
+    weights: &NoiseWeights,
+    use_profile: bool,
+) -> Refinement {
+    let mut params = *start;
+    let mut ne = accumulate(samples, active, &params, weights, use_profile);
+    let cost_before = ne.cost;
+    let mut lambda = 1e-6;
+    let mut iterations = 0;
+    let mut converged = false;
+    while iterations < MAX_ITERATIONS {
+        iterations += 1;
+        if ne.cost.is_nan() || ne.cost <= 0.0 {
+            converged = true;
+            break;
+        }
+        // Solve (H + λ diag H) δ = −g in unit-diagonal scaling.
+        let h = SMatrix::<f64, 6, 6>::from_fn(|i, j| ne.h[i][j]);
+        let (hs, s) = unit_diagonal(&h);
+        let damped = hs + SMatrix::<f64, 6, 6>::identity() * lambda;
+        let gs = SVector::<f64, 6>::from_fn(|i, _| ne.g[i] * s[i]);
+        let Some(chol) = damped.cholesky() else {
+            lambda *= 10.0;
+            if lambda > 1e12 {
+                break;
+            }
+            continue;
+        };
+        let step_scaled = -chol.solve(&gs);
+        // Predicted decrease of the quadratic model: −2gᵀδ − δᵀHδ.
+        let predicted = -2.0 * gs.dot(&step_scaled) - (hs * step_scaled).dot(&step_scaled);
+        if predicted <= RELATIVE_TOLERANCE * ne.cost {
+            converged = true;
+            break;
+        }
+        let mut v = params.to_vector();
+        for i in 0..6 {
+            v[i] += step_scaled[i] * s[i];
+        }
+        let trial = Params::from_vector(v);
+        let trial_ne = accumulate(samples, active, &trial, weights, use_profile);
+        if trial_ne.cost.is_finite() && trial_ne.cost <= ne.cost {
+            let decrease = ne.cost - trial_ne.cost;
+            params = trial;
+            ne = trial_ne;
+            lambda = (lambda * 0.1).max(1e-12);
+            if decrease <= RELATIVE_TOLERANCE * ne.cost {
+                converged = true;
+                break;
+            }
+        } else {
+            lambda *= 10.0;
+            if lambda > 1e12 {
+                converged = true;
+                break;
+            }
+        }
+    }
+    let cost_after = ne.cost;
+    Refinement {
+        params,
+        cost_before,
+        cost_after,
+        iterations,
+        converged,
+    }
+}
