@@ -1,11 +1,179 @@
-//! Placeholder: this subcommand is being written (owned by the helper named in the
-//! project plan); it must be replaced before submission.
+//! `odocal calibrate LOG`: raw log in, calibrated robot out.
 
-/// Arguments.
+use anyhow::Context;
+use odocal_log::{read_log, Mode, ReadOptions};
+use odocal_pipeline::{build_report, calibrate_log, write_outputs, Options, Progress, Trim};
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// The outlier-trimming rule, as named on the command line.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrimArg {
+    /// ICRA 2008: drop the worst 5 %, three times.
+    Icra,
+    /// The original package (T-RO 2013): p = 1 %, 4 rounds, xy or θ threshold.
+    Tro,
+    /// No trimming.
+    None,
+}
+
+impl From<TrimArg> for Trim {
+    fn from(t: TrimArg) -> Trim {
+        match t {
+            TrimArg::Icra => Trim::ICRA,
+            TrimArg::Tro => Trim::TRO,
+            TrimArg::None => Trim::None,
+        }
+    }
+}
+
+/// Arguments of `odocal calibrate`.
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// The log (Carmen-style text with ENCODER lines, or the original package's JSON log).
+    pub log: PathBuf,
+    /// Encoder ticks per wheel revolution (overrides the log's PARAM).
+    #[arg(long, value_name = "X")]
+    pub ticks_per_rev: Option<f64>,
+    /// Pair scans K apart (default: about 0.4 s apart at the log's scan rate).
+    #[arg(long, value_name = "K")]
+    pub stride: Option<usize>,
+    /// Outlier trimming rule.
+    #[arg(long, value_enum, default_value = "tro")]
+    pub trim: TrimArg,
+    /// Skip the maximum-likelihood refinement (closed form only).
+    #[arg(long)]
+    pub no_refine: bool,
+    /// Use the constant-speed formulas instead of the encoder profile.
+    #[arg(long)]
+    pub constant_speed: bool,
+    /// Estimate a constant clock offset between laser and encoders (within ±0.5 s).
+    #[arg(long)]
+    pub estimate_time_offset: bool,
+    /// Known clock offset (s): laser clock minus encoder clock.
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = 0.0,
+        allow_negative_numbers = true
+    )]
+    pub time_offset: f64,
+    /// Match the scans a second time, with first guesses from the first estimate.
+    #[arg(long)]
+    pub second_pass: bool,
+    /// Threads for scan matching (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Skip malformed lines (counted and reported) instead of stopping at the first.
+    #[arg(long)]
+    pub lenient: bool,
+    /// Write results.json, samples.tuple (and figures with --plots) into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// With --out: also write SVG figures.
+    #[arg(long, requires = "out")]
+    pub plots: bool,
+    /// Print one JSON object instead of the human summary.
+    #[arg(long)]
+    pub json: bool,
+}
 
-/// Runs the subcommand.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("not implemented yet")
+/// A progress bar on stderr, shown only when stderr is a terminal.
+pub struct Bar(Option<indicatif::ProgressBar>);
+
+impl Bar {
+    /// A bar when stderr is a terminal, nothing otherwise.
+    pub fn for_stderr() -> Bar {
+        use std::io::IsTerminal;
+        Bar(std::io::stderr()
+            .is_terminal()
+            .then(indicatif::ProgressBar::hidden))
+    }
+}
+
+impl Progress for Bar {
+    fn start(&self, stage: &str, total: usize) {
+        if let Some(b) = &self.0 {
+            b.set_draw_target(indicatif::ProgressDrawTarget::stderr());
+            b.reset();
+            b.set_length(total as u64);
+            b.set_position(0);
+            b.set_message(stage.to_string());
+            if let Ok(style) =
+                indicatif::ProgressStyle::with_template("{msg:>24} [{bar:40}] {pos}/{len} ({eta})")
+            {
+                b.set_style(style.progress_chars("=> "));
+            }
+        }
+    }
+    fn advance(&self) {
+        if let Some(b) = &self.0 {
+            b.inc(1);
+        }
+    }
+    fn finish(&self) {
+        if let Some(b) = &self.0 {
+            b.finish_and_clear();
+        }
+    }
+}
+
+/// A rayon pool with `threads` threads (all cores when `None`).
+pub fn thread_pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> {
+    if threads == Some(0) {
+        anyhow::bail!("--threads must be at least 1");
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .context("cannot start the scan-matching threads")
+}
+
+/// Runs `odocal calibrate`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let pool = thread_pool(args.threads)?;
+    let t_parse = Instant::now();
+    let log = read_log(
+        &args.log,
+        &ReadOptions {
+            mode: if args.lenient {
+                Mode::Lenient
+            } else {
+                Mode::Strict
+            },
+            ticks_per_revolution: args.ticks_per_rev,
+            ..ReadOptions::default()
+        },
+    )?;
+    let parse_s = t_parse.elapsed().as_secs_f64();
+
+    let mut opts = Options {
+        ticks_per_revolution: args.ticks_per_rev,
+        stride: args.stride,
+        use_profile: !args.constant_speed,
+        time_offset: args.time_offset,
+        estimate_time_offset: args.estimate_time_offset.then_some(0.5),
+        second_pass: args.second_pass,
+        ..Options::default()
+    };
+    opts.solve.trim = args.trim.into();
+    opts.solve.refine = !args.no_refine;
+
+    let bar = Bar::for_stderr();
+    let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
+    outcome.timing.parse = parse_s;
+    let report = build_report(&args.log, &log, &opts, &outcome);
+
+    if let Some(dir) = &args.out {
+        write_outputs(dir, &log, &opts, &outcome, &report, args.plots)?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print!("{report}");
+        if let Some(dir) = &args.out {
+            println!("results written to {}", dir.display());
+        }
+    }
+    Ok(())
 }

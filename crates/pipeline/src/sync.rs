@@ -1,7 +1,7 @@
 //! Synchronization of the encoder stream with the scan stream.
 //!
 //! A sample needs, for a pair of scans taken at `t0` and `t1` (laser clock), the wheel
-//! rotations over `[t0 + δ, t1 + δ]` on the encoder clock (δ = the clock offset, 0
+//! rotations over `[t0 − δ, t1 − δ]` on the encoder clock (δ = laser clock − encoder clock, 0
 //! unless estimated). Cumulative ticks are interpolated linearly between the two
 //! encoder records around each instant; the encoder *profile* inside the interval —
 //! the pieces between consecutive encoder records, clipped to the interval — is kept

@@ -1,0 +1,124 @@
+//! Parallel matching of scan pairs, with each scan prepared once.
+//!
+//! Pairs come as a chain — (0, k), (k, 2k), … — so the second scan of a pair is the
+//! first scan of the next. The pairs are cut into contiguous chunks; a worker walks a
+//! chunk in order, keeping the last prepared scan to reuse it as the next reference,
+//! so a scan is prepared once (twice at chunk boundaries). Each worker owns one
+//! matcher (scratch buffers). Every result depends only on its two scans, and results
+//! come back in pair order, so the output is the same whatever the thread count.
+
+use rayon::prelude::*;
+
+/// Pairs per chunk: large enough that preparing the boundary scan twice is rare,
+/// small enough to balance the load over the threads.
+pub const CHUNK_PAIRS: usize = 64;
+
+/// Matches every pair `(first, second)` (scan indices) in parallel.
+///
+/// - `prepare(i)` preprocesses scan `i` (done once per scan per chunk);
+/// - `new_matcher()` makes one matcher per worker;
+/// - `match_pair(matcher, pair_index, &reference, &current)` matches one pair;
+/// - `done()` is called once per pair matched (progress reporting).
+///
+/// Returns one result per pair, in the order of `pairs`.
+pub fn match_chain<P, M, R>(
+    pairs: &[(usize, usize)],
+    prepare: impl Fn(usize) -> P + Sync + Send,
+    new_matcher: impl Fn() -> M + Sync + Send,
+    match_pair: impl Fn(&mut M, usize, &P, &P) -> R + Sync + Send,
+    done: impl Fn() + Sync + Send,
+) -> Vec<R>
+where
+    R: Send,
+{
+    let chunks: Vec<Vec<R>> = pairs
+        .par_chunks(CHUNK_PAIRS)
+        .enumerate()
+        .map_init(new_matcher, |matcher, (c, chunk)| {
+            let mut out = Vec::with_capacity(chunk.len());
+            let mut last: Option<(usize, P)> = None;
+            for (k, &(a, b)) in chunk.iter().enumerate() {
+                let reference = match last.take() {
+                    Some((i, p)) if i == a => p,
+                    _ => prepare(a),
+                };
+                let current = prepare(b);
+                out.push(match_pair(
+                    matcher,
+                    c * CHUNK_PAIRS + k,
+                    &reference,
+                    &current,
+                ));
+                last = Some((b, current));
+                done();
+            }
+            out
+        })
+        .collect();
+    chunks.into_iter().flatten().collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    #[test]
+    fn results_in_order_and_scans_prepared_about_once() {
+        let pairs: Vec<(usize, usize)> = (0..1000).map(|i| (3 * i, 3 * i + 3)).collect();
+        let prepared = AtomicUsize::new(0);
+        let done = AtomicUsize::new(0);
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                match_chain(
+                    &pairs,
+                    |i| {
+                        prepared.fetch_add(1, Ordering::Relaxed);
+                        i as f64 * 0.5
+                    },
+                    || 0usize,
+                    |calls: &mut usize, k, a: &f64, b: &f64| {
+                        *calls += 1;
+                        (k, *a, *b)
+                    },
+                    || {
+                        done.fetch_add(1, Ordering::Relaxed);
+                    },
+                )
+            })
+        };
+        let one = run(1);
+        assert_eq!(
+            prepared.swap(0, Ordering::Relaxed),
+            1001 + 1000 / CHUNK_PAIRS
+        );
+        let two = run(2);
+        assert_eq!(one, two);
+        assert_eq!(done.load(Ordering::Relaxed), 2000);
+        for (k, r) in one.iter().enumerate() {
+            assert_eq!(*r, (k, 1.5 * k as f64, 1.5 * (k + 1) as f64));
+        }
+    }
+
+    #[test]
+    fn broken_chain_prepares_both_scans() {
+        let pairs = vec![(0, 2), (4, 6), (6, 8)];
+        let prepared = AtomicUsize::new(0);
+        let r = match_chain(
+            &pairs,
+            |i| {
+                prepared.fetch_add(1, Ordering::Relaxed);
+                i
+            },
+            || (),
+            |_, _, a: &usize, b: &usize| (*a, *b),
+            || {},
+        );
+        assert_eq!(r, pairs);
+        assert_eq!(prepared.load(Ordering::Relaxed), 5);
+    }
+}

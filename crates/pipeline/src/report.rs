@@ -1,0 +1,234 @@
+//! The report of a calibration: what `--json` prints and `results.json` holds, and
+//! the human summary.
+
+use crate::run::{Options, Outcome, Timing};
+use crate::sync::DiscardCounts;
+use odocal_log::Log;
+use odocal_solver::{Observability, PARAMETER_NAMES};
+use serde::Serialize;
+use std::fmt;
+use std::path::Path;
+
+/// Everything a user needs from one calibration.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Report {
+    /// The log calibrated.
+    pub log: String,
+    /// Left wheel radius (m).
+    pub r_l: f64,
+    /// Right wheel radius (m).
+    pub r_r: f64,
+    /// Wheel distance (m).
+    pub b: f64,
+    /// Laser x on the robot (m).
+    pub l_x: f64,
+    /// Laser y on the robot (m).
+    pub l_y: f64,
+    /// Laser heading on the robot (rad).
+    pub l_theta: f64,
+    /// Standard deviations, order r_L, r_R, b, ℓx, ℓy, ℓθ.
+    pub sigma: [f64; 6],
+    /// Covariance 6×6, order r_L, r_R, b, ℓx, ℓy, ℓθ.
+    pub covariance: [[f64; 6]; 6],
+    /// `J = [[r_L/2, r_R/2], [−r_L/b, r_R/b]]`.
+    pub j: [[f64; 2]; 2],
+    /// The closed-form estimate (before refinement): r_L, r_R, b, ℓx, ℓy, ℓθ.
+    pub closed_form: [f64; 6],
+    /// Samples used by the final estimate (after trimming).
+    pub samples_used: usize,
+    /// Samples handed to the solver (before trimming).
+    pub samples_synchronized: usize,
+    /// Samples removed by outlier trimming.
+    pub samples_trimmed: usize,
+    /// Scan pairs considered.
+    pub scan_pairs: usize,
+    /// Scan pairs discarded before the solver, by reason.
+    pub discarded: DiscardCounts,
+    /// Scans between the two of a pair.
+    pub stride: usize,
+    /// Median interval between the two scans of a sample (s).
+    pub interval_s: f64,
+    /// Encoder ticks per wheel revolution used.
+    pub ticks_per_revolution: f64,
+    /// Estimated scan-matching noise σ (x m, y m, θ rad).
+    pub sm_sigma: [f64; 3],
+    /// Weighted cost at the closed form and at the estimate.
+    pub cost_before: f64,
+    /// Weighted cost at the returned estimate.
+    pub cost_after: f64,
+    /// Observability verdicts.
+    pub observability: Observability,
+    /// Estimated clock offset (s, laser clock minus encoder clock), when asked.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_offset_s: Option<f64>,
+    /// Trimming rule, refinement, profile use.
+    pub settings: Settings,
+    /// Wall time per stage (s).
+    pub timing_s: Timing,
+}
+
+/// Settings worth recording with the results.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Settings {
+    /// The trimming rule.
+    pub trim: odocal_solver::Trim,
+    /// ML refinement on.
+    pub refine: bool,
+    /// Encoder profile (non-constant speeds) used.
+    pub use_profile: bool,
+    /// Second matching pass.
+    pub second_pass: bool,
+    /// Clock offset applied when not estimated (s).
+    pub time_offset_s: f64,
+}
+
+/// Builds the report of a finished calibration.
+pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -> Report {
+    let c = &outcome.calibration;
+    let v = c.params.to_vector();
+    let sigma: [f64; 6] = std::array::from_fn(|i| c.covariance[i][i].max(0.0).sqrt());
+    let mut intervals: Vec<f64> = outcome.synced.samples.iter().map(|s| s.wheel.dt).collect();
+    let interval_s = if intervals.is_empty() {
+        f64::NAN
+    } else {
+        let mid = intervals.len() / 2;
+        *intervals.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
+    let _ = log;
+    Report {
+        log: path.display().to_string(),
+        r_l: v[0],
+        r_r: v[1],
+        b: v[2],
+        l_x: v[3],
+        l_y: v[4],
+        l_theta: v[5],
+        sigma,
+        covariance: c.covariance,
+        j: c.j,
+        closed_form: c.closed_form.to_vector(),
+        samples_used: c.samples_used,
+        samples_synchronized: outcome.synced.samples.len(),
+        samples_trimmed: outcome.synced.samples.len().saturating_sub(c.samples_used),
+        scan_pairs: outcome.synced.pairs,
+        discarded: outcome.synced.discarded.clone(),
+        stride: outcome.synced.stride,
+        interval_s,
+        ticks_per_revolution: outcome.synced.ticks_per_revolution,
+        sm_sigma: c.sm_sigma,
+        cost_before: c.cost_before,
+        cost_after: c.cost_after,
+        observability: c.observability.clone(),
+        time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
+        settings: Settings {
+            trim: opts.solve.trim,
+            refine: opts.solve.refine,
+            use_profile: opts.use_profile,
+            second_pass: opts.second_pass,
+            time_offset_s: opts.time_offset,
+        },
+        timing_s: outcome.timing,
+    }
+}
+
+impl Report {
+    /// The estimate as `[r_L, r_R, b, ℓx, ℓy, ℓθ]`.
+    pub fn values(&self) -> [f64; 6] {
+        [self.r_l, self.r_r, self.b, self.l_x, self.l_y, self.l_theta]
+    }
+}
+
+impl fmt::Display for Report {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "odocal calibration of {}", self.log)?;
+        writeln!(f)?;
+        let v = self.values();
+        for i in 0..6 {
+            let verdict = self
+                .observability
+                .parameters
+                .get(i)
+                .map(|p| p.verdict.as_str())
+                .unwrap_or("");
+            if i == 5 {
+                writeln!(
+                    f,
+                    "  {:<8} = {:>+12.6} rad ± {:.6} rad  ({:+.3}° ± {:.3}°)  {}",
+                    PARAMETER_NAMES[i],
+                    v[i],
+                    self.sigma[i],
+                    v[i].to_degrees(),
+                    self.sigma[i].to_degrees(),
+                    verdict
+                )?;
+            } else {
+                writeln!(
+                    f,
+                    "  {:<8} = {:>+12.4} mm  ± {:.4} mm  {}",
+                    PARAMETER_NAMES[i],
+                    v[i] * 1e3,
+                    self.sigma[i] * 1e3,
+                    verdict
+                )?;
+            }
+        }
+        writeln!(f)?;
+        writeln!(
+            f,
+            "  J = [[{:+.6e}, {:+.6e}], [{:+.6e}, {:+.6e}]]",
+            self.j[0][0], self.j[0][1], self.j[1][0], self.j[1][1]
+        )?;
+        writeln!(f)?;
+        writeln!(
+            f,
+            "  samples: {} used of {} synchronized ({} trimmed as outliers); {} scan pairs, stride {} (≈{:.2} s)",
+            self.samples_used,
+            self.samples_synchronized,
+            self.samples_trimmed,
+            self.scan_pairs,
+            self.stride,
+            self.interval_s
+        )?;
+        let d: Vec<String> = self
+            .discarded
+            .0
+            .iter()
+            .map(|(k, n)| format!("{} {n}", k.replace('_', " ")))
+            .collect();
+        writeln!(f, "  discarded pairs: {}", d.join(", "))?;
+        writeln!(
+            f,
+            "  scan-matching noise σ: x {:.3} mm, y {:.3} mm, θ {:.4}°",
+            self.sm_sigma[0] * 1e3,
+            self.sm_sigma[1] * 1e3,
+            self.sm_sigma[2].to_degrees()
+        )?;
+        writeln!(
+            f,
+            "  cost: {:.4e} (closed form) → {:.4e}",
+            self.cost_before, self.cost_after
+        )?;
+        let o = &self.observability;
+        writeln!(
+            f,
+            "  observability: step-1 condition {:.1}, A condition {:.3e}; {}",
+            o.step1_condition, o.a_condition, o.sentence
+        )?;
+        if let Some(w) = &o.wheel_signs {
+            writeln!(f, "  warning: {w}")?;
+        }
+        if let Some(t) = self.time_offset_s {
+            writeln!(
+                f,
+                "  clock offset (laser clock − encoder clock): {:+.4} s",
+                t
+            )?;
+        }
+        let t = &self.timing_s;
+        writeln!(
+            f,
+            "  timing: parse {:.2} s, sync {:.3} s, match {:.2} s, clock offset {:.2} s, solve {:.3} s",
+            t.parse, t.sync, t.r#match, t.time_offset, t.solve
+        )
+    }
+}

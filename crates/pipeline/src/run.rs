@@ -1,0 +1,352 @@
+//! The whole pipeline: synchronize, match, (estimate the clock offset,) solve.
+
+use crate::error::PipelineError;
+use crate::matching::{match_pairs, MatchStats};
+use crate::progress::Progress;
+use crate::samples::PairSample;
+use crate::sync::{
+    default_stride, scan_pairs, DiscardCounts, DiscardReason, EncoderTrack, ScanPair, SyncLimits,
+    WheelMotion,
+};
+use crate::time_offset::{estimate_time_offset, OffsetEstimate};
+use odocal_geom::Pose2;
+use odocal_icp::IcpParams;
+use odocal_log::Log;
+use odocal_solver::{Calibration, Params, Predictor, SolveOptions};
+use std::time::Instant;
+
+/// Fewest samples the pipeline hands to the solver.
+pub const MIN_SAMPLES: usize = 20;
+
+/// Everything the pipeline can be told.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Encoder ticks per wheel revolution; overrides the log's PARAM when set.
+    pub ticks_per_revolution: Option<f64>,
+    /// Scan pairs `stride` scans apart; `None` picks intervals of about 0.4 s.
+    pub stride: Option<usize>,
+    /// Synchronization thresholds; `None` derives them from the streams.
+    pub limits: Option<SyncLimits>,
+    /// Use the encoder profile (non-constant-speed formulas).
+    pub use_profile: bool,
+    /// Pass ŝ's covariance from ICP to the solver (weights).
+    pub use_icp_covariance: bool,
+    /// Solver settings (trimming rule, refinement).
+    pub solve: SolveOptions,
+    /// Known clock offset (s): laser clock minus encoder clock (subtracted from scan timestamps).
+    pub time_offset: f64,
+    /// Estimate the offset within ±this many seconds (`None`: keep `time_offset`).
+    pub estimate_time_offset: Option<f64>,
+    /// Parameters for the first guess of scan matching (`None`: identity).
+    pub initial_params: Option<Params>,
+    /// Match again with first guesses predicted from the first estimate.
+    pub second_pass: bool,
+    /// Scan matcher settings.
+    pub icp: IcpParams,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            ticks_per_revolution: None,
+            stride: None,
+            limits: None,
+            use_profile: true,
+            use_icp_covariance: false,
+            solve: SolveOptions::default(),
+            time_offset: 0.0,
+            estimate_time_offset: None,
+            initial_params: None,
+            second_pass: false,
+            icp: IcpParams::default(),
+        }
+    }
+}
+
+/// Wall time per stage (s).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Timing {
+    /// Reading the log (filled by the caller that read it).
+    pub parse: f64,
+    /// Synchronization (encoder interpolation, profiles).
+    pub sync: f64,
+    /// Scan matching (all passes).
+    pub r#match: f64,
+    /// Clock-offset search (0 when not asked).
+    pub time_offset: f64,
+    /// Solving (closed form, trimming, refinement, covariance).
+    pub solve: f64,
+}
+
+/// Samples ready for the solver, and what was thrown away.
+#[derive(Debug, Clone)]
+pub struct Synchronized {
+    /// Scans between the two of a pair.
+    pub stride: usize,
+    /// The thresholds used.
+    pub limits: SyncLimits,
+    /// Ticks per revolution used.
+    pub ticks_per_revolution: f64,
+    /// Scan pairs considered.
+    pub pairs: usize,
+    /// Pairs that became samples, in time order.
+    pub samples: Vec<PairSample>,
+    /// Pairs discarded, per reason.
+    pub discarded: DiscardCounts,
+    /// Clock offset used (s): laser clock minus encoder clock.
+    pub time_offset: f64,
+}
+
+/// The result of [`calibrate_log`].
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// Samples and discards.
+    pub synced: Synchronized,
+    /// The solver's output.
+    pub calibration: Calibration,
+    /// The clock-offset search, when asked.
+    pub offset: Option<OffsetEstimate>,
+    /// Wall time per stage.
+    pub timing: Timing,
+}
+
+/// Ticks per revolution from the options or the log, checking the log has what
+/// calibration needs.
+fn ticks_per_revolution(log: &Log, opts: &Options) -> Result<f64, PipelineError> {
+    match opts.ticks_per_revolution {
+        Some(t) => {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(PipelineError::InvalidSetting(format!(
+                    "ticks per revolution must be a positive number, got {t}"
+                )));
+            }
+            // The log's own check reports missing encoders or scans before ticks.
+            if log.encoders.is_empty() || log.scans.len() < 2 {
+                log.check_calibration_inputs()?;
+            }
+            Ok(t)
+        }
+        None => Ok(log.check_calibration_inputs()?),
+    }
+}
+
+/// Wheel motions for every pair at a given clock offset.
+fn wheel_motions(
+    track: &EncoderTrack<'_>,
+    pairs: &[ScanPair],
+    limits: &SyncLimits,
+    offset: f64,
+) -> Vec<Result<WheelMotion, DiscardReason>> {
+    pairs
+        .iter()
+        .map(|p| track.motion(p.t0 - offset, p.t1 - offset, limits))
+        .collect()
+}
+
+/// First guesses of ŝ for each pair: identity, or predicted by odometry.
+fn first_guesses(
+    motions: &[(usize, WheelMotion)],
+    params: Option<&Params>,
+    use_profile: bool,
+) -> Vec<Pose2> {
+    match params {
+        None => vec![Pose2::IDENTITY; motions.len()],
+        Some(p) => {
+            let predictor = Predictor::new(p, use_profile);
+            motions
+                .iter()
+                .map(|(_, w)| {
+                    let s = crate::samples::wheel_only_sample(w);
+                    Pose2::from_array(predictor.predict(&s))
+                })
+                .collect()
+        }
+    }
+}
+
+/// Synchronizes the encoder and scan streams and matches the pairs.
+pub fn synchronize_and_match(
+    log: &Log,
+    opts: &Options,
+    progress: &dyn Progress,
+    timing: &mut Timing,
+) -> Result<Synchronized, PipelineError> {
+    let ticks = ticks_per_revolution(log, opts)?;
+    let t_sync = Instant::now();
+    let scan_times: Vec<f64> = log.scans.scans.iter().map(|s| s.t).collect();
+    let stride = match opts.stride {
+        Some(0) => {
+            return Err(PipelineError::InvalidSetting(
+                "the stride must be at least 1".into(),
+            ))
+        }
+        Some(k) => k,
+        None => default_stride(&scan_times),
+    };
+    let encoder_times: Vec<f64> = log.encoders.iter().map(|e| e.t).collect();
+    let limits = opts
+        .limits
+        .unwrap_or_else(|| SyncLimits::from_streams(&encoder_times, &scan_times, stride));
+    let track = EncoderTrack::new(&log.encoders, ticks);
+    let pairs = scan_pairs(&scan_times, stride);
+    let mut discarded = DiscardCounts::default();
+    let mut kept: Vec<(usize, WheelMotion)> = Vec::with_capacity(pairs.len());
+    for (k, m) in wheel_motions(&track, &pairs, &limits, opts.time_offset)
+        .into_iter()
+        .enumerate()
+    {
+        match m {
+            Ok(w) => kept.push((k, w)),
+            Err(reason) => discarded.add(reason),
+        }
+    }
+    timing.sync += t_sync.elapsed().as_secs_f64();
+
+    let t_match = Instant::now();
+    let index_pairs: Vec<(usize, usize)> = kept
+        .iter()
+        .map(|(k, _)| (pairs[*k].first, pairs[*k].second))
+        .collect();
+    let guesses = first_guesses(&kept, opts.initial_params.as_ref(), opts.use_profile);
+    progress.start("matching", index_pairs.len());
+    let matched = match_pairs(&log.scans, &index_pairs, &guesses, &opts.icp, || {
+        progress.advance()
+    });
+    progress.finish();
+    timing.r#match += t_match.elapsed().as_secs_f64();
+
+    let mut samples = Vec::with_capacity(kept.len());
+    for ((k, wheel), m) in kept.into_iter().zip(matched) {
+        match m {
+            Ok(icp) => samples.push(PairSample {
+                pair: pairs[k],
+                wheel,
+                icp,
+            }),
+            Err(_) => discarded.add(DiscardReason::MatchFailed),
+        }
+    }
+    Ok(Synchronized {
+        stride,
+        limits,
+        ticks_per_revolution: ticks,
+        pairs: pairs.len(),
+        samples,
+        discarded,
+        time_offset: opts.time_offset,
+    })
+}
+
+/// Matches the samples again with first guesses from `params`.
+fn second_pass(
+    log: &Log,
+    synced: &mut Synchronized,
+    params: &Params,
+    opts: &Options,
+    progress: &dyn Progress,
+) {
+    let motions: Vec<(usize, WheelMotion)> = synced
+        .samples
+        .iter()
+        .enumerate()
+        .map(|(k, s)| (k, s.wheel.clone()))
+        .collect();
+    let guesses = first_guesses(&motions, Some(params), opts.use_profile);
+    let index_pairs: Vec<(usize, usize)> = synced
+        .samples
+        .iter()
+        .map(|s| (s.pair.first, s.pair.second))
+        .collect();
+    progress.start("matching (second pass)", index_pairs.len());
+    let matched: Vec<Result<MatchStats, String>> =
+        match_pairs(&log.scans, &index_pairs, &guesses, &opts.icp, || {
+            progress.advance()
+        });
+    progress.finish();
+    let old = std::mem::take(&mut synced.samples);
+    for (s, m) in old.into_iter().zip(matched) {
+        match m {
+            Ok(icp) => synced.samples.push(PairSample { icp, ..s }),
+            Err(_) => synced.discarded.add(DiscardReason::MatchFailed),
+        }
+    }
+}
+
+/// Recomputes every sample's wheel motion at a new clock offset, discarding (and
+/// counting) the pairs that no longer synchronize.
+pub fn resynchronize(log: &Log, synced: &mut Synchronized, offset: f64) {
+    let track = EncoderTrack::new(&log.encoders, synced.ticks_per_revolution);
+    let old = std::mem::take(&mut synced.samples);
+    for s in old {
+        match track.motion(s.pair.t0 - offset, s.pair.t1 - offset, &synced.limits) {
+            Ok(wheel) => synced.samples.push(PairSample { wheel, ..s }),
+            Err(reason) => synced.discarded.add(reason),
+        }
+    }
+    synced.time_offset = offset;
+}
+
+fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineError> {
+    if synced.samples.len() < MIN_SAMPLES {
+        return Err(PipelineError::TooFewSamples {
+            usable: synced.samples.len(),
+            pairs: synced.pairs,
+            needed: MIN_SAMPLES,
+            discarded: synced.discarded.clone(),
+        });
+    }
+    let samples: Vec<_> = synced
+        .samples
+        .iter()
+        .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
+        .collect();
+    Ok(odocal_solver::calibrate(&samples, &opts.solve)?)
+}
+
+/// Runs the pipeline on a log already in memory. Scan matching runs on rayon's
+/// current thread pool (wrap the call in `ThreadPool::install` to choose the count).
+pub fn calibrate_log(
+    log: &Log,
+    opts: &Options,
+    progress: &dyn Progress,
+) -> Result<Outcome, PipelineError> {
+    let mut timing = Timing::default();
+    let mut synced = synchronize_and_match(log, opts, progress, &mut timing)?;
+
+    let t_solve = Instant::now();
+    let mut calibration = solve(&synced, opts)?;
+    timing.solve += t_solve.elapsed().as_secs_f64();
+
+    if opts.second_pass {
+        let t = Instant::now();
+        second_pass(log, &mut synced, &calibration.params, opts, progress);
+        timing.r#match += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        calibration = solve(&synced, opts)?;
+        timing.solve += t.elapsed().as_secs_f64();
+    }
+
+    let mut offset = None;
+    if let Some(range) = opts.estimate_time_offset {
+        if !(range.is_finite() && range > 0.0) {
+            return Err(PipelineError::InvalidSetting(format!(
+                "the clock-offset search range must be positive, got {range} s"
+            )));
+        }
+        let t = Instant::now();
+        let est = estimate_time_offset(log, &synced, opts, opts.time_offset, range, &calibration)?;
+        resynchronize(log, &mut synced, est.offset);
+        timing.time_offset += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        calibration = solve(&synced, opts)?;
+        timing.solve += t.elapsed().as_secs_f64();
+        offset = Some(est);
+    }
+
+    Ok(Outcome {
+        synced,
+        calibration,
+        offset,
+        timing,
+    })
+}
