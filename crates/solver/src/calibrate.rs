@@ -241,12 +241,10 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         )));
     }
 
-    let r_scale = if params.r_l.abs() + params.r_r.abs() > 0.0 {
-        (params.r_l, params.r_r)
-    } else {
-        (1.0, 1.0)
-    };
-    let motion = MotionContent::classify(samples, &active, r_scale.0, r_scale.1);
+    // Motion classes with the estimated radii; for the "not excited" errors, where
+    // the estimate is not trustworthy, with equal radii.
+    let motion = MotionContent::classify(samples, &active, params.r_l, params.r_r);
+    let motion_equal_radii = MotionContent::classify(samples, &active, 1.0, 1.0);
     let information = accumulate(samples, &active, &params, &weights, options.use_profile).h;
     let covariance = match invert_information(&information) {
         Inversion::Covariance(c) => *c,
@@ -264,7 +262,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         .map(|r| r.name.clone())
         .collect();
     if !not_excited.is_empty() {
-        return Err(information_not_excited(not_excited, &motion));
+        return Err(information_not_excited(not_excited, &motion_equal_radii));
     }
     let observability = Observability {
         step1_condition: cf.step1.condition,

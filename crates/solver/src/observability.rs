@@ -12,15 +12,15 @@ use serde::Serialize;
 /// Radii and wheel distance: relative σ below which they are well determined.
 pub const RELATIVE_SIGMA_WELL: f64 = 0.02;
 /// Radii and wheel distance: relative σ above which they count as not excited.
-pub const RELATIVE_SIGMA_NOT_EXCITED: f64 = 0.5;
+pub const RELATIVE_SIGMA_NOT_EXCITED: f64 = 0.2;
 /// ℓx, ℓy: σ as a fraction of the wheel distance below which they are well determined.
 pub const OFFSET_SIGMA_WELL: f64 = 0.05;
 /// ℓx, ℓy: σ as a fraction of the wheel distance above which they count as not excited.
-pub const OFFSET_SIGMA_NOT_EXCITED: f64 = 1.0;
+pub const OFFSET_SIGMA_NOT_EXCITED: f64 = 0.2;
 /// ℓθ: σ (rad) below which it is well determined (about 3°).
 pub const ANGLE_SIGMA_WELL: f64 = 0.05;
-/// ℓθ: σ (rad) above which it counts as not excited (about 29°).
-pub const ANGLE_SIGMA_NOT_EXCITED: f64 = 0.5;
+/// ℓθ: σ (rad) above which it counts as not excited (20°).
+pub const ANGLE_SIGMA_NOT_EXCITED: f64 = 0.35;
 /// A sample turns "in place" when its forward wheel travel is below this fraction
 /// of its turning wheel travel, and goes "straight" in the opposite case.
 pub const MOTION_CLASS_RATIO: f64 = 0.1;
@@ -203,13 +203,15 @@ fn advice(names: &[&str], motion: &MotionContent) -> String {
     if odometry && lacks("straight runs") {
         tips.push("straight runs");
     }
-    if odometry && lacks("spins in place") && lacks("turning while translating") {
+    if odometry && lacks("spins in place") {
         tips.push("spins in place");
     }
-    if offset && lacks("spins in place") && lacks("turning while translating") {
+    let turns_present = !(lacks("spins in place") && lacks("turning while translating"));
+    if offset && !turns_present && !tips.contains(&"spins in place") {
         tips.push("turns (spins in place or arcs)");
     }
-    if heading && lacks("straight runs") && lacks("turning while translating") {
+    let translation_present = !(lacks("straight runs") && lacks("turning while translating"));
+    if heading && !translation_present && !tips.contains(&"straight runs") {
         tips.push("translation (straight runs or arcs)");
     }
     tips.dedup();
@@ -317,9 +319,12 @@ pub(crate) fn step1_not_excited(samples: &[Sample], active: &[usize], s1: &Step1
                 .into(),
         };
     }
-    // The excited direction is orthogonal to the weakest one.
+    // The excited direction is orthogonal to the weakest one; classify it like a
+    // sample (forward and turning wheel travel, radii taken equal).
     let u = [-s1.weakest_direction[1], s1.weakest_direction[0]];
-    if (u[0] - u[1]).abs() < 0.2 {
+    let forward = (0.5 * (u[0] + u[1])).abs();
+    let turning = (0.5 * (u[1] - u[0])).abs();
+    if turning < MOTION_CLASS_RATIO * forward {
         SolveError::NotExcited {
             parameters: names(&["b", "l_x", "l_y"]),
             sentence: format!(
@@ -329,7 +334,7 @@ pub(crate) fn step1_not_excited(samples: &[Sample], active: &[usize], s1: &Step1
                 motion.describe()
             ),
         }
-    } else if (u[0] + u[1]).abs() < 0.2 {
+    } else if forward < MOTION_CLASS_RATIO * turning {
         SolveError::NotExcited {
             parameters: names(&PARAMETER_NAMES),
             sentence: format!(

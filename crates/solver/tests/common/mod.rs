@@ -83,7 +83,8 @@ pub fn random_params(rng: &mut StdRng, laser_theta: Option<f64>) -> Params {
         laser: Pose2::new(
             rng.random_range(-0.5..0.5) * b,
             rng.random_range(-0.5..0.5) * b,
-            laser_theta.unwrap_or_else(|| rng.random_range(-std::f64::consts::PI..std::f64::consts::PI)),
+            laser_theta
+                .unwrap_or_else(|| rng.random_range(-std::f64::consts::PI..std::f64::consts::PI)),
         ),
     }
 }
