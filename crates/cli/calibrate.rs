@@ -61,6 +61,9 @@ pub struct Args {
     /// Match the scans a second time, with first guesses from the first estimate.
     #[arg(long)]
     pub second_pass: bool,
+    /// Print the numbers even when some parameters are only weakly determined.
+    #[arg(long)]
+    pub accept_weak: bool,
     /// Threads for scan matching (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
@@ -144,7 +147,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             ticks_per_revolution: args.ticks_per_rev,
             ..ReadOptions::default()
         },
-    )?;
+    )
+    // The reader's message already says everything (file, line, cause).
+    .map_err(|e| anyhow::anyhow!("{e}"))?;
     let parse_s = t_parse.elapsed().as_secs_f64();
 
     let mut opts = Options {
@@ -154,6 +159,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         time_offset: args.time_offset,
         estimate_time_offset: args.estimate_time_offset.then_some(0.5),
         second_pass: args.second_pass,
+        accept_weak: args.accept_weak,
         ..Options::default()
     };
     opts.solve.trim = args.trim.into();

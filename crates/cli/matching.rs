@@ -51,7 +51,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             ticks_per_revolution: args.ticks_per_rev,
             ..ReadOptions::default()
         },
-    )?;
+    )
+    // The reader's message already says everything (file, line, cause).
+    .map_err(|e| anyhow::anyhow!("{e}"))?;
     let opts = Options {
         ticks_per_revolution: args.ticks_per_rev,
         stride: args.stride,

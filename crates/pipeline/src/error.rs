@@ -29,6 +29,18 @@ pub enum PipelineError {
     /// The solver refused (not excited, too few samples after trimming, …).
     #[error(transparent)]
     Solve(#[from] SolveError),
+    /// The solver returned numbers, but some parameters are so poorly determined
+    /// (verdict "weak" or "not excited") that they would mislead.
+    #[error(
+        "the data do not determine {} well enough: {sentence} (pass --accept-weak to see the numbers anyway)",
+        parameters.join(", ")
+    )]
+    NotDetermined {
+        /// The parameters concerned (`r_L`, `r_R`, `b`, `l_x`, `l_y`, `l_theta`).
+        parameters: Vec<String>,
+        /// The solver's observability sentence: what motion is missing.
+        sentence: String,
+    },
     /// A setting is out of range.
     #[error("invalid setting: {0}")]
     InvalidSetting(String),

@@ -12,7 +12,7 @@ use crate::time_offset::{estimate_time_offset, OffsetEstimate};
 use odocal_geom::Pose2;
 use odocal_icp::IcpParams;
 use odocal_log::Log;
-use odocal_solver::{Calibration, Params, Predictor, SolveOptions};
+use odocal_solver::{Calibration, Params, Predictor, SolveOptions, Verdict};
 use std::time::Instant;
 
 /// Fewest samples the pipeline hands to the solver.
@@ -43,6 +43,9 @@ pub struct Options {
     pub second_pass: bool,
     /// Scan matcher settings.
     pub icp: IcpParams,
+    /// Return numbers even when some parameters are only weakly determined (by
+    /// default that is an error naming them).
+    pub accept_weak: bool,
 }
 
 impl Default for Options {
@@ -59,6 +62,7 @@ impl Default for Options {
             initial_params: None,
             second_pass: false,
             icp: IcpParams::default(),
+            accept_weak: false,
         }
     }
 }
@@ -300,7 +304,21 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         .iter()
         .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
         .collect();
-    Ok(odocal_solver::calibrate(&samples, &opts.solve)?)
+    let calibration = odocal_solver::calibrate(&samples, &opts.solve)?;
+    let poor: Vec<String> = calibration
+        .observability
+        .parameters
+        .iter()
+        .filter(|p| p.verdict != Verdict::WellDetermined)
+        .map(|p| p.name.clone())
+        .collect();
+    if !poor.is_empty() && !opts.accept_weak {
+        return Err(PipelineError::NotDetermined {
+            parameters: poor,
+            sentence: calibration.observability.sentence.clone(),
+        });
+    }
+    Ok(calibration)
 }
 
 /// Runs the pipeline on a log already in memory. Scan matching runs on rayon's

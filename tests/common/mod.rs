@@ -1,0 +1,50 @@
+//! Helpers shared by the end-to-end tests: simulated logs in a temporary directory.
+
+#![allow(dead_code)]
+
+use odocal_sim::{simulate, SimConfig};
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// The six true parameters, in the order r_L, r_R, b, ℓx, ℓy, ℓθ.
+pub type Truth = [f64; 6];
+
+/// A fresh directory under the system's temporary directory.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("odocal-e2e-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("create a temporary directory");
+    dir
+}
+
+/// Simulates `preset` (after `tweak`) and writes `DIR/NAME.log`; returns the path and
+/// the true parameters.
+pub fn simulated_log(
+    name: &str,
+    preset: &str,
+    duration: f64,
+    seed: u64,
+    tweak: impl FnOnce(&mut SimConfig),
+) -> (PathBuf, Truth) {
+    let mut config = SimConfig::preset(preset).expect("preset exists");
+    config.duration = duration;
+    config.seed = seed;
+    tweak(&mut config);
+    let run = simulate(&config).expect("simulation runs");
+    let dir = temp_dir(name);
+    let path = dir.join(format!("{name}.log"));
+    let file = File::create(&path).expect("create the log");
+    let summary = run
+        .write_log(BufWriter::new(file), &[])
+        .expect("write the log");
+    let p = run.ground_truth(&summary).params;
+    (path, [p.r_l, p.r_r, p.b, p.l_x, p.l_y, p.l_theta])
+}
+
+/// Removes a test's directory (best effort).
+pub fn cleanup(path: &Path) {
+    if let Some(dir) = path.parent() {
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}
