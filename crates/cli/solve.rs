@@ -1,11 +1,243 @@
-//! Placeholder: this subcommand is being written (owned by the helper named in the
-//! project plan); it must be replaced before submission.
+//! `odocal solve TUPLES [--trim icra|tro|none] [--no-refine] [--json]`: the six
+//! parameters, their covariance and the observability report from a tuple file
+//! (the original package's `{T, phi_l, phi_r, sm}` stream, or ours with `sm_cov`
+//! and wheel-speed profiles).
 
-/// Arguments.
+use anyhow::Context;
+use odocal_geom::Pose2;
+use odocal_log::{read_tuples, TupleRecord};
+use odocal_solver::{
+    calibrate, Calibration, ProfileSegment, Sample, SolveOptions, Trim, Verdict, PARAMETER_NAMES,
+};
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// Outlier-trimming rule of the command line.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrimRule {
+    /// ICRA 2008: drop the worst 5 % three times.
+    Icra,
+    /// Original package (T-RO 2013): p = 1 %, 4 rounds, drop above either threshold.
+    Tro,
+    /// Keep every sample.
+    None,
+}
+
+impl TrimRule {
+    fn name(self) -> &'static str {
+        match self {
+            TrimRule::Icra => "icra",
+            TrimRule::Tro => "tro",
+            TrimRule::None => "none",
+        }
+    }
+
+    fn to_trim(self) -> Trim {
+        match self {
+            TrimRule::Icra => Trim::ICRA,
+            TrimRule::Tro => Trim::TRO,
+            TrimRule::None => Trim::None,
+        }
+    }
+}
+
+/// Arguments of `odocal solve`.
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// Tuple file: a stream of JSON objects {"T", "phi_l", "phi_r", "sm"[, "sm_cov", "profile"]}.
+    pub tuples: PathBuf,
+    /// Outlier trimming between closed-form solves.
+    #[arg(long, value_enum, default_value = "tro")]
+    pub trim: TrimRule,
+    /// Return the closed form without maximum-likelihood refinement.
+    #[arg(long)]
+    pub no_refine: bool,
+    /// Ignore wheel-speed profiles (use the constant-speed formulas).
+    #[arg(long)]
+    pub no_profile: bool,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
 
-/// Runs the subcommand.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("not implemented yet")
+/// A tuple record as a solver sample.
+pub fn sample_from_record(rec: &TupleRecord) -> Sample {
+    let mut s = Sample::from_speeds(rec.t, rec.phi_l, rec.phi_r, Pose2::from_array(rec.sm));
+    s.sm_cov = rec.sm_cov;
+    s.profile = rec.profile.as_ref().map(|pieces| {
+        pieces
+            .iter()
+            .map(|p| ProfileSegment {
+                duration: p[0],
+                dphi_l: p[1],
+                dphi_r: p[2],
+            })
+            .collect()
+    });
+    s
+}
+
+/// The JSON printed by `--json`.
+#[derive(Serialize)]
+struct JsonOutput<'a> {
+    r_l: f64,
+    r_r: f64,
+    b: f64,
+    l_x: f64,
+    l_y: f64,
+    l_theta: f64,
+    covariance: [[f64; 6]; 6],
+    j: [[f64; 2]; 2],
+    samples_used: usize,
+    samples_total: usize,
+    samples_per_round: &'a [usize],
+    trim: Trim,
+    refined: bool,
+    closed_form: &'a odocal_solver::Params,
+    sm_sigma: [f64; 3],
+    noise_source: odocal_solver::NoiseSource,
+    cost_before: f64,
+    cost_after: f64,
+    observability: &'a odocal_solver::Observability,
+}
+
+/// Runs `odocal solve`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let records = read_tuples(&args.tuples)?;
+    let samples: Vec<Sample> = records.iter().map(sample_from_record).collect();
+    let options = SolveOptions {
+        trim: args.trim.to_trim(),
+        refine: !args.no_refine,
+        use_profile: !args.no_profile,
+        ..SolveOptions::default()
+    };
+    let cal = calibrate(&samples, &options)
+        .with_context(|| format!("{}: calibration failed", args.tuples.display()))?;
+    if args.json {
+        let p = &cal.params;
+        let out = JsonOutput {
+            r_l: p.r_l,
+            r_r: p.r_r,
+            b: p.b,
+            l_x: p.laser.x,
+            l_y: p.laser.y,
+            l_theta: p.laser.theta,
+            covariance: cal.covariance,
+            j: cal.j,
+            samples_used: cal.samples_used,
+            samples_total: samples.len(),
+            samples_per_round: &cal.samples_per_round,
+            trim: options.trim,
+            refined: cal.refinement.is_some(),
+            closed_form: &cal.closed_form,
+            sm_sigma: cal.sm_sigma,
+            noise_source: cal.noise_source,
+            cost_before: cal.cost_before,
+            cost_after: cal.cost_after,
+            observability: &cal.observability,
+        };
+        let mut text = serde_json::to_string_pretty(&out).context("serializing the result")?;
+        text.push('\n');
+        write_stdout(&text)
+    } else {
+        write_stdout(&summary(&args, &cal, samples.len()))
+    }
+}
+
+/// Writes to standard output; a closed pipe (e.g. `| head`) is not an error.
+fn write_stdout(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(e).context("writing to standard output")
+        }
+        _ => Ok(()),
+    }
+}
+
+/// The human-readable summary.
+fn summary(args: &Args, cal: &Calibration, total: usize) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let rounds: Vec<String> = cal
+        .samples_per_round
+        .iter()
+        .map(|n| n.to_string())
+        .collect();
+    let _ = writeln!(
+        s,
+        "{}: {} of {} samples used (trimming {}: {})",
+        args.tuples.display(),
+        cal.samples_used,
+        total,
+        args.trim.name(),
+        rounds.join(" → ")
+    );
+    let units = ["m", "m", "m", "m", "m", "rad"];
+    for (i, rep) in cal.observability.parameters.iter().enumerate() {
+        let mark = match rep.verdict {
+            Verdict::WellDetermined => "",
+            Verdict::Weak | Verdict::NotExcited => "  <--",
+        };
+        let _ = writeln!(
+            s,
+            "  {:<8} = {:>13.8} {:<3} ± {:.2e}  {}{}",
+            PARAMETER_NAMES[i],
+            rep.value,
+            units[i],
+            rep.sigma,
+            rep.verdict.as_str(),
+            mark
+        );
+    }
+    let _ = writeln!(
+        s,
+        "  ℓθ = {:.4}° ± {:.4}°",
+        cal.params.laser.theta.to_degrees(),
+        cal.observability.parameters[5].sigma.to_degrees()
+    );
+    let j = cal.j;
+    let _ = writeln!(
+        s,
+        "  J = [[{:.6e}, {:.6e}], [{:.6e}, {:.6e}]]",
+        j[0][0], j[0][1], j[1][0], j[1][1]
+    );
+    let _ = writeln!(
+        s,
+        "  scan-matching noise σ = ({:.3} mm, {:.3} mm, {:.4}°) from the residuals; weights: {}",
+        cal.sm_sigma[0] * 1e3,
+        cal.sm_sigma[1] * 1e3,
+        cal.sm_sigma[2].to_degrees(),
+        match cal.noise_source {
+            odocal_solver::NoiseSource::Estimated => "these σ",
+            odocal_solver::NoiseSource::SampleCovariance => "each sample's sm_cov",
+        }
+    );
+    match &cal.refinement {
+        Some(r) => {
+            let _ = writeln!(
+                s,
+                "  ML refinement: cost {:.6e} → {:.6e} in {} iterations{}",
+                r.cost_before,
+                r.cost_after,
+                r.iterations,
+                if r.converged { "" } else { " (not converged)" }
+            );
+        }
+        None => {
+            let _ = writeln!(s, "  closed form only: cost {:.6e}", cal.cost_before);
+        }
+    }
+    let o = &cal.observability;
+    let _ = writeln!(
+        s,
+        "  condition numbers: step 1 {:.1}, A {:.3e} (unit-diagonal {:.1})",
+        o.step1_condition, o.a_condition, o.a_condition_scaled
+    );
+    let _ = writeln!(s, "  {}", o.sentence);
+    if let Some(w) = &o.wheel_signs {
+        let _ = writeln!(s, "  warning: {w}");
+    }
+    s
 }
