@@ -1,11 +1,277 @@
-//! Placeholder: this subcommand is being written (owned by the helper named in the
-//! project plan); it must be replaced before submission.
+//! `odocal simulate`: write a simulated log (`PREFIX.log`) and its ground truth
+//! (`PREFIX.truth.json`) from a preset, with every parameter overridable.
 
-/// Arguments.
+use anyhow::Context;
+use odocal_geom::Pose2;
+use odocal_sim::{simulate, PresetRegistry, SimConfig, TrajectoryKind};
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `odocal simulate`.
 #[derive(clap::Args, Debug)]
-pub struct Args {}
+pub struct Args {
+    /// Preset to start from: khepera, khepera-displaced, office, corridor, straight-only,
+    /// spin-only, identical-turns, or a row of the Table I file.
+    #[arg(long, default_value = "khepera")]
+    preset: String,
+    /// Seed of every random choice (same seed and options → same bytes).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Length of the run (s); default: the preset's.
+    #[arg(long)]
+    duration: Option<f64>,
+    /// Output prefix: writes PREFIX.log and PREFIX.truth.json.
+    #[arg(long, required_unless_present = "list_presets")]
+    out: Option<PathBuf>,
+    /// Table I file whose rows become presets (default: fixtures/table-i.json when it
+    /// exists, in the current directory or the source tree).
+    #[arg(long)]
+    table: Option<PathBuf>,
+    /// List the preset names and exit.
+    #[arg(long)]
+    list_presets: bool,
+    /// Print the effective configuration (JSON) to stdout before simulating.
+    #[arg(long)]
+    print_config: bool,
 
-/// Runs the subcommand.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("not implemented yet")
+    /// True left wheel radius (m).
+    #[arg(long)]
+    r_l: Option<f64>,
+    /// True right wheel radius (m).
+    #[arg(long)]
+    r_r: Option<f64>,
+    /// True wheel distance (m).
+    #[arg(long)]
+    b: Option<f64>,
+    /// True laser x in the robot frame (m).
+    #[arg(long, allow_hyphen_values = true)]
+    laser_x: Option<f64>,
+    /// True laser y in the robot frame (m).
+    #[arg(long, allow_hyphen_values = true)]
+    laser_y: Option<f64>,
+    /// True laser heading in the robot frame (rad).
+    #[arg(long, allow_hyphen_values = true)]
+    laser_theta: Option<f64>,
+    /// Encoder ticks per wheel revolution.
+    #[arg(long)]
+    ticks_per_rev: Option<f64>,
+    /// Encoder counters wrap modulo this (e.g. 65536); written as a PARAM.
+    #[arg(long)]
+    modulus: Option<u64>,
+    /// Encoder counts at the start, left and right (e.g. 65000,12).
+    #[arg(long, value_delimiter = ',', num_args = 2, allow_hyphen_values = true)]
+    initial_ticks: Option<Vec<i64>>,
+    /// Encoder records per second.
+    #[arg(long)]
+    encoder_rate: Option<f64>,
+    /// Encoder timing jitter (± s, uniform).
+    #[arg(long)]
+    encoder_jitter: Option<f64>,
+    /// Scans per second.
+    #[arg(long)]
+    scan_rate: Option<f64>,
+    /// Scan timing jitter (± s, uniform).
+    #[arg(long)]
+    scan_jitter: Option<f64>,
+    /// World: khepera-arena, office or corridor.
+    #[arg(long)]
+    world: Option<String>,
+    /// Trajectory: mixed, straight-only, spin-only or identical-turns.
+    #[arg(long)]
+    trajectory: Option<String>,
+    /// Range noise standard deviation per reading (m).
+    #[arg(long)]
+    range_noise: Option<f64>,
+    /// Number of neighbouring rays the range noise is correlated over.
+    #[arg(long)]
+    noise_correlation: Option<usize>,
+    /// Range quantization step (m); 0 = none.
+    #[arg(long)]
+    quantization: Option<f64>,
+    /// Probability of a random reading failure (reported as 0).
+    #[arg(long)]
+    dropout: Option<f64>,
+    /// Exact scans: no range noise, no quantization, no random failures.
+    #[arg(long)]
+    noise_free: bool,
+    /// Laser clock minus encoder clock (s).
+    #[arg(long, allow_hyphen_values = true)]
+    clock_offset: Option<f64>,
+    /// Wheel-slip episodes per minute.
+    #[arg(long)]
+    slip: Option<f64>,
+    /// Fraction of ENCODER/RAWLASER1 messages dropped.
+    #[arg(long)]
+    drop: Option<f64>,
+    /// Probability per message of a malformed line after it.
+    #[arg(long)]
+    garbage: Option<f64>,
+    /// Motor lag time constant (s).
+    #[arg(long)]
+    motor_tau: Option<f64>,
+    /// Largest forward speed (m/s).
+    #[arg(long)]
+    max_speed: Option<f64>,
+    /// Largest turn rate (rad/s).
+    #[arg(long)]
+    max_turn_rate: Option<f64>,
+    /// Smallest distance to walls kept by the planner (m).
+    #[arg(long)]
+    clearance: Option<f64>,
+    /// Radius of the identical-turns circle (m).
+    #[arg(long)]
+    turn_radius: Option<f64>,
+    /// Encoder-clock time of the start (s).
+    #[arg(long)]
+    start_time: Option<f64>,
+    /// Host name on every line.
+    #[arg(long)]
+    hostname: Option<String>,
+    /// Do not write ODOM messages.
+    #[arg(long)]
+    no_odom: bool,
+}
+
+/// Runs `odocal simulate`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let registry = registry(args.table.as_deref())?;
+    if args.list_presets {
+        for name in registry.names() {
+            println!("{name}");
+        }
+        return Ok(());
+    }
+    let mut config = registry.get(&args.preset)?;
+    apply_overrides(&mut config, &args)?;
+    config.validate()?;
+    if args.print_config {
+        println!("{}", serde_json::to_string_pretty(&config)?);
+    }
+    let Some(prefix) = args.out.as_deref() else {
+        anyhow::bail!("--out PREFIX is required");
+    };
+    let log_path = with_suffix(prefix, ".log");
+    let truth_path = with_suffix(prefix, ".truth.json");
+
+    let started = std::time::Instant::now();
+    let sim = simulate(&config)?;
+    let header = vec![format!("generated by: {}", command_line())];
+    let log_file = std::fs::File::create(&log_path)
+        .with_context(|| format!("cannot create {}", log_path.display()))?;
+    let summary = sim
+        .write_log(BufWriter::new(log_file), &header)
+        .with_context(|| format!("writing {}", log_path.display()))?;
+    let truth_file = std::fs::File::create(&truth_path)
+        .with_context(|| format!("cannot create {}", truth_path.display()))?;
+    sim.write_truth(&summary, BufWriter::new(truth_file))
+        .with_context(|| format!("writing {}", truth_path.display()))?;
+    let bytes = std::fs::metadata(&log_path).map(|m| m.len()).unwrap_or(0);
+    println!(
+        "{}: {} scans, {} encoder records, {} odom records, {} garbage lines, {:.2} MB, {:.1} s simulated in {:.2} s",
+        log_path.display(),
+        summary.scans,
+        summary.encoder_records,
+        summary.odom_records,
+        summary.garbage_lines.len(),
+        bytes as f64 / 1e6,
+        config.duration,
+        started.elapsed().as_secs_f64()
+    );
+    println!("{}: ground truth", truth_path.display());
+    Ok(())
+}
+
+/// The preset registry: built-in presets plus the rows of a Table I file.
+fn registry(table: Option<&Path>) -> anyhow::Result<PresetRegistry> {
+    if let Some(path) = table {
+        return Ok(PresetRegistry::builtin().with_table_file(path)?);
+    }
+    let local = Path::new("fixtures/table-i.json");
+    if local.exists() {
+        return Ok(PresetRegistry::builtin().with_table_file(local)?);
+    }
+    Ok(PresetRegistry::standard()?)
+}
+
+fn apply_overrides(c: &mut SimConfig, a: &Args) -> anyhow::Result<()> {
+    fn set<T: Copy>(target: &mut T, value: Option<T>) {
+        if let Some(v) = value {
+            *target = v;
+        }
+    }
+    set(&mut c.seed, a.seed);
+    set(&mut c.duration, a.duration);
+    set(&mut c.robot.r_l, a.r_l);
+    set(&mut c.robot.r_r, a.r_r);
+    set(&mut c.robot.b, a.b);
+    let l = c.robot.laser;
+    c.robot.laser = Pose2::new(
+        a.laser_x.unwrap_or(l.x),
+        a.laser_y.unwrap_or(l.y),
+        a.laser_theta.unwrap_or(l.theta),
+    );
+    set(&mut c.encoder.ticks_per_revolution, a.ticks_per_rev);
+    if a.modulus.is_some() {
+        c.encoder.modulus = a.modulus;
+    }
+    if let Some(t) = &a.initial_ticks {
+        c.encoder.initial_ticks = [t[0], t[1]];
+    }
+    set(&mut c.encoder.rate_hz, a.encoder_rate);
+    set(&mut c.encoder.jitter_s, a.encoder_jitter);
+    set(&mut c.laser.rate_hz, a.scan_rate);
+    set(&mut c.laser.jitter_s, a.scan_jitter);
+    if let Some(w) = &a.world {
+        odocal_sim::World::preset(w)?;
+        c.world = w.clone();
+    }
+    if let Some(t) = &a.trajectory {
+        c.trajectory = TrajectoryKind::from_name(t)?;
+    }
+    if a.noise_free {
+        c.laser.range_sigma = 0.0;
+        c.laser.quantization = 0.0;
+        c.laser.dropout_probability = 0.0;
+    }
+    set(&mut c.laser.range_sigma, a.range_noise);
+    set(&mut c.laser.correlation_rays, a.noise_correlation);
+    set(&mut c.laser.quantization, a.quantization);
+    set(&mut c.laser.dropout_probability, a.dropout);
+    set(&mut c.faults.clock_offset, a.clock_offset);
+    set(&mut c.faults.slip_per_minute, a.slip);
+    set(&mut c.faults.drop_fraction, a.drop);
+    set(&mut c.faults.garbage_fraction, a.garbage);
+    set(&mut c.motors.time_constant, a.motor_tau);
+    set(&mut c.motion.max_speed, a.max_speed);
+    set(&mut c.motion.max_turn_rate, a.max_turn_rate);
+    set(&mut c.motion.clearance, a.clearance);
+    set(&mut c.motion.turn_radius, a.turn_radius);
+    set(&mut c.start_time, a.start_time);
+    if let Some(h) = &a.hostname {
+        c.hostname = h.clone();
+    }
+    if a.no_odom {
+        c.write_odom = false;
+    }
+    Ok(())
+}
+
+/// `PREFIX` + `suffix` (appended, not replacing an extension: `run.v2` → `run.v2.log`).
+fn with_suffix(prefix: &Path, suffix: &str) -> PathBuf {
+    let mut s = prefix.as_os_str().to_os_string();
+    s.push(suffix);
+    PathBuf::from(s)
+}
+
+/// The command as invoked, with the program named `odocal`, for the log's header.
+fn command_line() -> String {
+    let mut parts = vec!["odocal".to_string()];
+    parts.extend(std::env::args().skip(1).map(|a| {
+        if a.is_empty() || a.contains(char::is_whitespace) {
+            format!("'{a}'")
+        } else {
+            a
+        }
+    }));
+    parts.join(" ")
 }

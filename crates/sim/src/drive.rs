@@ -118,9 +118,8 @@ impl Drive {
     pub fn set_command(&mut self, command: [f64; 2], slip: [f64; 2]) {
         let h = self.substep();
         let tau = self.motors.time_constant;
-        for i in 0..2 {
+        for (i, &c) in command.iter().enumerate() {
             let w0 = self.motor_speeds[i];
-            let c = command[i];
             if tau > 0.0 {
                 let decay = (-h / tau).exp();
                 let increment = c * h + (w0 - c) * tau * (-(-h / tau).exp_m1());

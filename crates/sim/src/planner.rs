@@ -152,6 +152,33 @@ pub struct Planner {
     line: Option<([f64; 2], [f64; 2], f64)>,
     /// For identical turns: the signed curvature of the circle (1/m).
     circle_curvature: f64,
+    /// Where the mixed trajectory has been planning from.
+    visits: VisitGrid,
+}
+
+/// Counts of planning positions per 0.5 m cell.
+#[derive(Debug, Clone, Default)]
+struct VisitGrid {
+    counts: std::collections::HashMap<(i64, i64), u32>,
+}
+
+impl VisitGrid {
+    const CELL: f64 = 0.5;
+
+    fn key(p: [f64; 2]) -> (i64, i64) {
+        (
+            (p[0] / Self::CELL).floor() as i64,
+            (p[1] / Self::CELL).floor() as i64,
+        )
+    }
+
+    fn record(&mut self, p: [f64; 2]) {
+        *self.counts.entry(Self::key(p)).or_insert(0) += 1;
+    }
+
+    fn count(&self, p: [f64; 2]) -> u32 {
+        self.counts.get(&Self::key(p)).copied().unwrap_or(0)
+    }
 }
 
 impl Planner {
@@ -197,6 +224,7 @@ impl Planner {
             started: 0.0,
             line,
             circle_curvature,
+            visits: VisitGrid::default(),
         };
         Ok((planner, start))
     }
@@ -344,6 +372,10 @@ impl Planner {
         // Relax the clearance if the robot is closer than planned (after slip, say).
         let needed = lim.clearance.min(world.clearance(here) - 0.01).max(0.05);
         let floor = 0.66 * needed;
+        // Among a few reachable goals, head for the least visited place (exploration).
+        self.visits.record(here);
+        let mut best: Option<(u32, [f64; 2], bool, f64)> = None;
+        let mut found = 0;
         for _ in 0..300 {
             let r = self.rng.random_range(0.3..2.5);
             let a = self
@@ -355,21 +387,32 @@ impl Planner {
             }
             let local = pose.inverse().transform_point(goal);
             let bearing = local[1].atan2(local[0]);
-            if want_arc && bearing.abs() < 1.2 && arc_clearance(world, pose, local) >= needed {
-                self.queue
-                    .push_back(Maneuver::Pursue { goal, speed, floor });
-                return;
+            let arc_ok =
+                want_arc && bearing.abs() < 1.2 && arc_clearance(world, pose, local) >= needed;
+            let line_ok = !want_arc && world.path_clearance(here, goal) >= needed;
+            if !(arc_ok || line_ok) {
+                continue;
             }
-            if !want_arc && world.path_clearance(here, goal) >= needed {
+            let visits = self.visits.count(goal);
+            if best.is_none_or(|b| visits < b.0) {
+                best = Some((visits, goal, arc_ok, bearing));
+            }
+            found += 1;
+            if found == 6 {
+                break;
+            }
+        }
+        if let Some((_, goal, arc, bearing)) = best {
+            if !arc {
                 let rate = self.rng.random_range(0.3..=lim.max_turn_rate);
                 self.queue.push_back(Maneuver::Spin {
                     target: wrap_angle(pose.theta + bearing),
                     rate,
                 });
-                self.queue
-                    .push_back(Maneuver::Pursue { goal, speed, floor });
-                return;
             }
+            self.queue
+                .push_back(Maneuver::Pursue { goal, speed, floor });
+            return;
         }
         // Nothing reachable this way: turn around and try again.
         self.queue.push_back(Maneuver::Spin {
