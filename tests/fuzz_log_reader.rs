@@ -1,0 +1,200 @@
+//! Fuzzing the log reader (and the pipeline behind it) with proptest: garbage bytes,
+//! garbled lines among valid ones, and mutated JSON logs. Every input must give
+//! `Ok` or an error — never a panic — in strict and in lenient mode; whatever reads
+//! is then pushed through the whole pipeline, which must also answer without panic.
+
+mod common;
+
+use odocal_log::{read_log, Mode, ReadOptions};
+use odocal_pipeline::{calibrate_log, NoProgress, Options};
+use proptest::prelude::*;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+static COUNTER: AtomicUsize = AtomicUsize::new(0);
+
+fn scratch_file(bytes: &[u8]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("odocal-fuzz-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{}.log", COUNTER.fetch_add(1, Ordering::Relaxed)));
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+/// Reads `bytes` as a log in both modes and, when it reads, calibrates it.
+fn exercise(bytes: &[u8]) {
+    let path = scratch_file(bytes);
+    for mode in [Mode::Strict, Mode::Lenient] {
+        let opts = ReadOptions {
+            mode,
+            ..ReadOptions::default()
+        };
+        if let Ok(log) = read_log(&path, &opts) {
+            let calib = Options {
+                ticks_per_revolution: Some(1000.0),
+                ..Options::default()
+            };
+            // Ok or a clear error; the point is that nothing panics.
+            let _ = calibrate_log(&log, &calib, &NoProgress).map(|o| o.calibration.params);
+        }
+    }
+    let _ = std::fs::remove_file(&path);
+}
+
+/// A small valid Carmen log: PARAMs, encoders at 50 Hz, scans of 11 rays at 10 Hz.
+fn valid_lines() -> Vec<String> {
+    let mut lines = vec![
+        "# CARMEN Logfile".to_string(),
+        "PARAM robot_wheel_ticks_per_revolution 2764.8 host 0.0".to_string(),
+        "PARAM robot_encoder_modulus 65536 host 0.0".to_string(),
+    ];
+    for k in 0..60 {
+        let t = 100.0 + k as f64 * 0.02;
+        lines.push(format!("ENCODER {} {} {t:.6} host {t:.6}", 3 * k, 5 * k));
+        if k % 5 == 0 {
+            let ranges: Vec<String> = (0..11)
+                .map(|i| format!("{:.3}", 1.0 + 0.1 * i as f64))
+                .collect();
+            lines.push(format!(
+                "RAWLASER1 2 -1.5 3.0 0.3 4.0 0.01 0 11 {} 0 {t:.6} host {t:.6}",
+                ranges.join(" ")
+            ));
+        }
+        if k % 7 == 0 {
+            lines.push(format!("ODOM 0.1 0.2 0.3 0.0 0.0 0.0 {t:.6} host {t:.6}"));
+        }
+    }
+    lines.push("FLASER 3 1.0 1.1 1.2 0 0 0 0 0 0 101.5 host 101.5".into());
+    lines.push("SYNC 1 2 3".into());
+    lines
+}
+
+/// Tokens that stress number parsing and counts.
+fn nasty_token() -> impl Strategy<Value = String> {
+    prop_oneof![
+        Just("NaN".to_string()),
+        Just("inf".to_string()),
+        Just("-inf".to_string()),
+        Just("1e400".to_string()),
+        Just("-0".to_string()),
+        Just("99999999999999999999999".to_string()),
+        Just("4294967296".to_string()),
+        Just("".to_string()),
+        Just("{".to_string()),
+        Just("\u{00e9}\u{2603}".to_string()),
+        any::<i64>().prop_map(|v| v.to_string()),
+        any::<f64>().prop_map(|v| v.to_string()),
+        "[ -~]{0,12}",
+    ]
+}
+
+#[derive(Debug, Clone)]
+enum Edit {
+    ReplaceToken(usize, usize, String),
+    DeleteToken(usize, usize),
+    InsertLine(usize, String),
+    DeleteLine(usize),
+    SwapLines(usize, usize),
+    Truncate(usize, usize),
+}
+
+fn edit() -> impl Strategy<Value = Edit> {
+    prop_oneof![
+        (any::<usize>(), any::<usize>(), nasty_token())
+            .prop_map(|(l, t, s)| Edit::ReplaceToken(l, t, s)),
+        (any::<usize>(), any::<usize>()).prop_map(|(l, t)| Edit::DeleteToken(l, t)),
+        (any::<usize>(), "[ -~\t]{0,80}").prop_map(|(l, s)| Edit::InsertLine(l, s)),
+        any::<usize>().prop_map(Edit::DeleteLine),
+        (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Edit::SwapLines(a, b)),
+        (any::<usize>(), any::<usize>()).prop_map(|(l, c)| Edit::Truncate(l, c)),
+    ]
+}
+
+fn edit_tokens(line: &mut String, t: usize, replacement: Option<&str>) {
+    let mut toks: Vec<String> = line.split_whitespace().map(String::from).collect();
+    if toks.is_empty() {
+        return;
+    }
+    let k = t % toks.len();
+    match replacement {
+        Some(r) => toks[k] = r.to_string(),
+        None => {
+            toks.remove(k);
+        }
+    }
+    *line = toks.join(" ");
+}
+
+fn apply(lines: &mut Vec<String>, e: &Edit) {
+    if lines.is_empty() {
+        return;
+    }
+    let n = lines.len();
+    match e {
+        Edit::ReplaceToken(l, t, s) => edit_tokens(&mut lines[l % n], *t, Some(s)),
+        Edit::DeleteToken(l, t) => edit_tokens(&mut lines[l % n], *t, None),
+        Edit::InsertLine(l, s) => lines.insert(l % (n + 1), s.clone()),
+        Edit::DeleteLine(l) => {
+            lines.remove(l % n);
+        }
+        Edit::SwapLines(a, b) => lines.swap(a % n, b % n),
+        Edit::Truncate(l, c) => {
+            let line = &mut lines[l % n];
+            let mut cut = c % (line.len() + 1);
+            while !line.is_char_boundary(cut) {
+                cut -= 1;
+            }
+            line.truncate(cut);
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+
+    #[test]
+    fn garbage_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..3000)) {
+        exercise(&bytes);
+    }
+
+    #[test]
+    fn garbled_carmen_lines_never_panic(edits in proptest::collection::vec(edit(), 0..12)) {
+        let mut lines = valid_lines();
+        for e in &edits {
+            apply(&mut lines, e);
+        }
+        exercise(lines.join("\n").as_bytes());
+    }
+
+    #[test]
+    fn garbled_json_logs_never_panic(
+        edits in proptest::collection::vec((any::<usize>(), "[ -~]{0,6}"), 0..6),
+        n in 0usize..12,
+    ) {
+        let mut text = String::new();
+        for k in 0..n {
+            text += &format!(
+                "{{\"timestamp\": [100, {}], \"readings\": [1.0, 1.1, 1.2], \"theta\": [-0.1, 0.0, 0.1], \
+                 \"left\": {}, \"right\": {}, \"leftTimestamp\": [100, {}], \"rightTimestamp\": [100, {}]}}\n",
+                k * 100_000, 3 * k, 4 * k, k * 100_000, k * 100_000
+            );
+        }
+        let mut bytes = text.into_bytes();
+        for (pos, ins) in &edits {
+            let p = if bytes.is_empty() { 0 } else { pos % bytes.len() };
+            bytes.splice(p..p, ins.bytes());
+        }
+        exercise(&bytes);
+    }
+}
+
+#[test]
+fn the_unedited_fixture_reads() {
+    // The generator above makes a readable log: the fuzzing starts from valid input.
+    let text = valid_lines().join("\n");
+    let path = scratch_file(text.as_bytes());
+    let log = read_log(&path, &ReadOptions::default()).expect("valid fixture");
+    assert_eq!(log.encoders.len(), 60);
+    assert_eq!(log.scans.len(), 13);
+    let _ = std::fs::remove_file(&path);
+}
