@@ -198,6 +198,11 @@ impl<'o> LogBuilder<'o> {
             })
             .sum();
         log.stats.invalid_readings = invalid;
+        // Memory ≈ the ranges themselves: drop the growth slack of the packed stores.
+        log.scans.ranges.shrink_to_fit();
+        log.scans.remissions.shrink_to_fit();
+        log.scans.scans.shrink_to_fit();
+        log.encoders.shrink_to_fit();
         self.log
     }
 }
