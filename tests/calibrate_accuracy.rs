@@ -46,7 +46,7 @@ fn check(label: &str, report: &Report, truth: &Truth) {
                 NAMES[i], bounds[i]
             ));
         }
-        if !(err.abs() <= 3.0 * sigma) {
+        if err.is_nan() || err.abs() > 3.0 * sigma {
             failures.push(format!(
                 "{}: error {err:.3e} beyond 3σ = {:.3e}",
                 NAMES[i],

@@ -257,7 +257,8 @@ impl<'a> EncoderTrack<'a> {
         t1: f64,
         limits: &SyncLimits,
     ) -> Result<WheelMotion, DiscardReason> {
-        if !(t1 > t0) || t1 - t0 > limits.max_interval {
+        if t1.partial_cmp(&t0) != Some(std::cmp::Ordering::Greater) || t1 - t0 > limits.max_interval
+        {
             return Err(DiscardReason::IntervalTooLong);
         }
         let i0 = self.bracket(t0, limits.max_encoder_gap)?;

@@ -89,7 +89,7 @@ impl Problem<'_> {
 
     fn cost(&self, offset: f64) -> f64 {
         let samples = self.samples_at(offset);
-        let mut solve = self.opts.solve.clone();
+        let mut solve = self.opts.solve;
         solve.refine = false;
         match odocal_solver::calibrate(&samples, &solve) {
             Ok(c) => self.cost_with(&c.params, &samples),
