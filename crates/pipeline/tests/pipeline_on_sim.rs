@@ -1,0 +1,97 @@
+//! The pipeline on short simulated logs: the synchronized wheel rotations agree with
+//! the simulator's true wheel angles to within the encoder quantization, the clock
+//! offset is applied with the simulator's sign, and the results do not depend on the
+//! number of threads.
+
+use odocal_log::{read_log, Log, ReadOptions};
+use odocal_pipeline::{calibrate_log, synchronize_and_match, NoProgress, Options, Timing};
+use odocal_sim::{simulate, SimConfig, SimRun};
+use std::f64::consts::TAU;
+
+fn sim(seed: u64, duration: f64, clock_offset: f64) -> (SimRun, Log) {
+    let mut config = SimConfig::preset("khepera").unwrap();
+    config.seed = seed;
+    config.duration = duration;
+    config.faults.clock_offset = clock_offset;
+    let run = simulate(&config).unwrap();
+    let path =
+        std::env::temp_dir().join(format!("odocal-pipeline-{}-{seed}.log", std::process::id()));
+    let file = std::fs::File::create(&path).unwrap();
+    run.write_log(std::io::BufWriter::new(file), &[]).unwrap();
+    let log = read_log(&path, &ReadOptions::default()).unwrap();
+    let _ = std::fs::remove_file(&path);
+    (run, log)
+}
+
+fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+/// Wheel rotations from interpolated ticks vs the simulator's exact wheel angles at the
+/// scan instants: within about one tick (quantization of the two interpolated counts).
+fn worst_rotation_error(run: &SimRun, log: &Log, opts: &Options) -> (f64, usize) {
+    let mut timing = Timing::default();
+    let synced = synchronize_and_match(log, opts, &NoProgress, &mut timing).unwrap();
+    let scans: Vec<_> = run.logged_scans().collect();
+    assert_eq!(scans.len(), log.scans.len());
+    let tick = TAU / run.config.encoder.ticks_per_revolution;
+    let mut worst: f64 = 0.0;
+    for s in &synced.samples {
+        let (a, b) = (scans[s.pair.first], scans[s.pair.second]);
+        assert_eq!(a.t, s.pair.t0);
+        let true_l = b.wheel_angles[0] - a.wheel_angles[0];
+        let true_r = b.wheel_angles[1] - a.wheel_angles[1];
+        worst = worst
+            .max((s.wheel.dphi_l - true_l).abs())
+            .max((s.wheel.dphi_r - true_r).abs());
+        let sum: f64 = s.wheel.profile.iter().map(|p| p.dphi_l).sum();
+        assert!((sum - s.wheel.dphi_l).abs() < 1e-9);
+    }
+    println!("worst wheel-rotation error: {:.3} ticks", worst / tick);
+    (worst / tick, synced.samples.len())
+}
+
+#[test]
+fn wheel_rotations_match_the_truth() {
+    let (run, log) = sim(31, 60.0, 0.0);
+    let (worst, n) = worst_rotation_error(&run, &log, &Options::default());
+    assert!(worst <= 1.5, "worst error {worst} ticks");
+    assert!(n > 130, "{n} samples");
+}
+
+#[test]
+fn clock_offset_uses_the_simulator_sign() {
+    let (run, log) = sim(32, 60.0, 0.05);
+    // With the right offset the rotations agree with the truth …
+    let opts = Options {
+        time_offset: 0.05,
+        ..Options::default()
+    };
+    let (worst, _) = worst_rotation_error(&run, &log, &opts);
+    assert!(worst <= 1.5, "worst error {worst} ticks");
+    // … with the opposite sign they do not.
+    let wrong = Options {
+        time_offset: -0.05,
+        ..Options::default()
+    };
+    let (worst, _) = worst_rotation_error(&run, &log, &wrong);
+    assert!(
+        worst > 10.0,
+        "a wrong offset went unnoticed ({worst} ticks)"
+    );
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let (_, log) = sim(33, 90.0, 0.0);
+    let opts = Options::default();
+    let one = in_pool(1, || calibrate_log(&log, &opts, &NoProgress).unwrap());
+    let two = in_pool(2, || calibrate_log(&log, &opts, &NoProgress).unwrap());
+    assert_eq!(one.synced.samples, two.synced.samples);
+    assert_eq!(one.calibration.params, two.calibration.params);
+    assert_eq!(one.calibration.covariance, two.calibration.covariance);
+}
