@@ -328,10 +328,11 @@ impl CarmenReader<'_> {
         ranges: &mut Vec<f32>,
         remissions: &mut Vec<f32>,
     ) -> Result<f64, FieldError> {
-        let explain = |e: FieldError, f: &Fields<'_>| FieldError {
+        let explain = |e: FieldError, f: &Fields<'_>, k: Option<usize>| FieldError {
             expected: format!(
-                "{} (num_readings = {n}; {} token(s) left on the line)",
+                "{} (num_readings = {n}{}; {} token(s) left on the line)",
                 e.expected,
+                k.map_or(String::new(), |k| format!(", num_remissions = {k}")),
                 f.tokens.count_remaining()
             ),
             found: e.found,
@@ -339,12 +340,12 @@ impl CarmenReader<'_> {
         for _ in 0..n {
             match f.f32("range reading") {
                 Ok(r) => ranges.push(r),
-                Err(e) => return Err(explain(e, f)),
+                Err(e) => return Err(explain(e, f, None)),
             }
         }
-        let k = f.count("num_remissions").map_err(|e| explain(e, f))?;
+        let k = f.count("num_remissions").map_err(|e| explain(e, f, None))?;
         for _ in 0..k {
-            remissions.push(f.f32("remission").map_err(|e| explain(e, f))?);
+            remissions.push(f.f32("remission").map_err(|e| explain(e, f, Some(k)))?);
         }
         if msg == Message::RobotLaser1 {
             for what in [
@@ -360,10 +361,10 @@ impl CarmenReader<'_> {
                 "side_safety_dist",
                 "turn_axis",
             ] {
-                f.f64(what).map_err(|e| explain(e, f))?;
+                f.f64(what).map_err(|e| explain(e, f, Some(k)))?;
             }
         }
-        Self::trailer(f).map_err(|e| explain(e, f))
+        Self::trailer(f).map_err(|e| explain(e, f, Some(k)))
     }
 
     /// The index of the geometry described by `h` with `n` rays, reusing a stored one.

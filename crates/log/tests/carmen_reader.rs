@@ -66,7 +66,7 @@ fn spec_example_reads_with_exact_values() {
 #[test]
 fn every_error_kind_names_file_line_message_and_expectation() {
     let good = "PARAM robot_wheel_ticks_per_revolution 100 h 0\nENCODER 1 2 10.0 h 10.0\n";
-    let cases: [(&str, &str, &[&str]); 16] = [
+    let cases: &[(&str, &str, &[&str])] = &[
         (
             "ENCODER 1.5 2 11.0 h 11.0",
             "ENCODER",
@@ -139,12 +139,42 @@ fn every_error_kind_names_file_line_message_and_expectation() {
             &["ticks per revolution (a positive number)", "`-5`"],
         ),
         (
+            "PARAM laser_front_laser_fov 0",
+            "PARAM",
+            &["field of view (a positive number, rad)", "`0`"],
+        ),
+        (
+            "PARAM laser_front_laser_min_range abc",
+            "PARAM",
+            &["minimum range", "`abc`"],
+        ),
+        (
+            "RAWLASER1 2 nan 1 0.5 4 0.01 0 3 1.5 2.5 3.5 0 11.0 h 11.0",
+            "RAWLASER1",
+            &["start_angle (a finite number)", "`nan`"],
+        ),
+        (
+            "RAWLASER1 2 -0.5 1 0.5 nan 0.01 0 3 1.5 2.5 3.5 0 11.0 h 11.0",
+            "RAWLASER1",
+            &["maximum_range"],
+        ),
+        (
+            "RAWLASER1 2 -0.5 1 0.5 4 0.01 0 3 1.5 2.5 3.5 1 11.0 h 11.0",
+            "RAWLASER1",
+            &["num_readings = 3, num_remissions = 1", "timestamp"],
+        ),
+        (
+            "FLASER 2 1 2 0 0 0 0 0 11.0 h 11.0",
+            "FLASER",
+            &["num_readings = 2"],
+        ),
+        (
             "PARAM robot_encoder_modulus 65536.5",
             "PARAM",
             &["encoder modulus"],
         ),
     ];
-    for (bad, msg, needles) in cases {
+    for &(bad, msg, needles) in cases {
         let text = format!("{good}# comment\n\n{bad}\nENCODER 3 4 12.0 h 12.0\n");
         let (line, err) = error_of(&text);
         assert_eq!(line, 5, "{bad} → {err}");
@@ -574,4 +604,26 @@ fn a_log_from_another_writer_gives_exact_counts() {
         assert_eq!(log.params.ticks_per_revolution.as_ref().unwrap().0, 2764.8);
         assert_eq!(log.check_calibration_inputs().unwrap(), 2764.8);
     }
+}
+
+/// Memory stays at about the size of the ranges: one geometry, no growth slack.
+#[test]
+fn stored_scans_cost_about_their_ranges() {
+    let g = odocal_log::ScanGeometry::urg_04lx();
+    let mut w = odocal_log::LogWriter::new(Vec::new(), "h");
+    let ranges: Vec<f32> = (0..681).map(|i| 0.5 + i as f32 * 0.001).collect();
+    for k in 0..300 {
+        w.rawlaser1(k as f64 * 0.1, &g, &ranges).unwrap();
+    }
+    let text = w.into_inner();
+    let log = read_carmen_from(&text[..], "m", &ReadOptions::default()).unwrap();
+    assert_eq!(log.scans.geometries.len(), 1);
+    assert_eq!(log.scans.ranges.len(), 300 * 681);
+    assert_eq!(log.scans.ranges.capacity(), log.scans.ranges.len());
+    let per_scan_overhead = std::mem::size_of::<odocal_log::ScanMeta>();
+    assert!(
+        per_scan_overhead * 10 < 681 * 4,
+        "{per_scan_overhead} bytes per scan"
+    );
+    assert_eq!(log.scans.get(299).unwrap().ranges, &ranges[..]);
 }
