@@ -132,9 +132,14 @@ impl<'o> LogBuilder<'o> {
                 let stats = &mut self.log.stats;
                 stats.skipped_lines += 1;
                 if stats.first_skipped.len() < FIRST_SKIPPED_KEPT {
-                    stats
-                        .first_skipped
-                        .push((err.line().unwrap_or(0), err.to_string()));
+                    // The line number is kept apart; the text is "MESSAGE: expected …".
+                    let text = match &err {
+                        LogError::Parse {
+                            message, expected, ..
+                        } => format!("{message}: {expected}"),
+                        other => other.to_string(),
+                    };
+                    stats.first_skipped.push((err.line().unwrap_or(0), text));
                 }
                 Ok(())
             }
