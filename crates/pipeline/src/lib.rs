@@ -28,6 +28,8 @@ pub mod run;
 pub mod samples;
 pub mod svg;
 pub mod sync;
+/// Regression against published calibration results (ICRA 2008 Table I, T-RO 2013).
+pub mod table_i;
 pub mod time_offset;
 
 pub use error::PipelineError;

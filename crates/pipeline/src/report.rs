@@ -14,6 +14,8 @@ use std::path::Path;
 pub struct Report {
     /// The log calibrated.
     pub log: String,
+    /// What the reader found in it.
+    pub log_contents: LogContents,
     /// Left wheel radius (m).
     pub r_l: f64,
     /// Right wheel radius (m).
@@ -67,6 +69,21 @@ pub struct Report {
     pub timing_s: Timing,
 }
 
+/// Counts from the log reader.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LogContents {
+    /// Scans read.
+    pub scans: usize,
+    /// ENCODER records read.
+    pub encoder_records: usize,
+    /// Malformed lines skipped (lenient mode).
+    pub skipped_lines: u64,
+    /// The first skipped lines: (1-based line, error).
+    pub first_skipped: Vec<(u64, String)>,
+    /// Messages of unknown names, skipped.
+    pub unknown_messages: u64,
+}
+
 /// Settings worth recording with the results.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Settings {
@@ -94,9 +111,15 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         let mid = intervals.len() / 2;
         *intervals.select_nth_unstable_by(mid, f64::total_cmp).1
     };
-    let _ = log;
     Report {
         log: path.display().to_string(),
+        log_contents: LogContents {
+            scans: log.scans.len(),
+            encoder_records: log.encoders.len(),
+            skipped_lines: log.stats.skipped_lines,
+            first_skipped: log.stats.first_skipped.clone(),
+            unknown_messages: log.stats.unknown.values().sum(),
+        },
         r_l: v[0],
         r_r: v[1],
         b: v[2],
@@ -141,6 +164,21 @@ impl Report {
 impl fmt::Display for Report {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "odocal calibration of {}", self.log)?;
+        let c = &self.log_contents;
+        writeln!(
+            f,
+            "  {} scans, {} encoder records",
+            c.scans, c.encoder_records
+        )?;
+        if c.skipped_lines > 0 {
+            let lines: Vec<String> = c.first_skipped.iter().map(|(l, _)| l.to_string()).collect();
+            writeln!(
+                f,
+                "  warning: {} malformed line(s) skipped (first: {})",
+                c.skipped_lines,
+                lines.join(", ")
+            )?;
+        }
         writeln!(f)?;
         let v = self.values();
         for i in 0..6 {
