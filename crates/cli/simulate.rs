@@ -190,7 +190,7 @@ fn registry(table: Option<&Path>) -> anyhow::Result<PresetRegistry> {
     if local.exists() {
         return Ok(PresetRegistry::builtin().with_table_file(local)?);
     }
-    Ok(PresetRegistry::standard()?)
+    Ok(PresetRegistry::standard())
 }
 
 fn apply_overrides(c: &mut SimConfig, a: &Args) -> anyhow::Result<()> {

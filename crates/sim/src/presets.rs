@@ -60,6 +60,8 @@ pub struct TableParams {
 pub struct PresetRegistry {
     rows: Vec<TableRow>,
     table: Option<PathBuf>,
+    /// Why the project's Table I file could not be used, when it exists but is bad.
+    table_error: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -84,12 +86,20 @@ impl PresetRegistry {
     }
 
     /// The built-in presets plus the rows of the project's Table I file, if it exists.
-    pub fn standard() -> Result<Self, SimError> {
+    ///
+    /// A Table I file that cannot be used does not take the built-in presets down:
+    /// its error is reported when an unknown preset name is asked for.
+    pub fn standard() -> Self {
         let path = Self::default_table_path();
-        if path.exists() {
-            Self::builtin().with_table_file(&path)
-        } else {
-            Ok(Self::builtin())
+        if !path.exists() {
+            return Self::builtin();
+        }
+        match Self::builtin().with_table_file(&path) {
+            Ok(r) => r,
+            Err(e) => PresetRegistry {
+                table_error: Some(e.to_string()),
+                ..Self::builtin()
+            },
         }
     }
 
@@ -165,7 +175,9 @@ impl PresetRegistry {
             return Ok(c);
         }
         let mut known = self.names().join(", ");
-        if self.table.is_none() {
+        if let Some(e) = &self.table_error {
+            known.push_str(&format!("; Table I rows unavailable: {e}"));
+        } else if self.table.is_none() {
             known.push_str(&format!(
                 "; Table I rows become presets when {} exists",
                 Self::default_table_path().display()
@@ -183,7 +195,7 @@ impl SimConfig {
     /// The preset `name` from [`PresetRegistry::standard`] (built-in presets and, when
     /// `fixtures/table-i.json` exists, its rows).
     pub fn preset(name: &str) -> Result<SimConfig, SimError> {
-        PresetRegistry::standard()?.get(name)
+        PresetRegistry::standard().get(name)
     }
 }
 
