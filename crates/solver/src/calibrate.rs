@@ -5,7 +5,7 @@ use crate::covariance::{invert_information, Inversion};
 use crate::error::SolveError;
 use crate::kinematics::Predictor;
 use crate::noise::{residual_sigmas, NoiseWeights};
-use crate::normal_equations::{accumulate, cost};
+use crate::normal_equations::accumulate;
 use crate::observability::{
     information_not_excited, null_direction_names, parameter_reports, sentence, step1_not_excited,
     step2_not_excited, wheel_signs, MotionContent, Observability, Verdict,
@@ -146,7 +146,7 @@ pub fn closed_form(
         .iter()
         .zip(&unit)
         .map(|(&k, u)| {
-            let p = pred.sensor_from_odometry([s2.b * u[0], s2.b * u[1], u[2]]);
+            let p = pred.sensor_from_odometry(&u.scale_translation(s2.b));
             let s = &samples[k].sm;
             [p[0] - s.x, p[1] - s.y, wrap_angle(p[2] - s.theta)]
         })
@@ -228,12 +228,14 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         None => (NoiseWeights::from_sigmas(sm_sigma), NoiseSource::Estimated),
     };
 
-    let (params, refinement, cost_before, cost_after) = if options.refine {
-        let r = refine(samples, &active, &cf.params, &weights, options.use_profile);
-        (r.params, Some(r), r.cost_before, r.cost_after)
+    // The last pass of the refinement (or one pass at the closed form) gives the
+    // cost and the Fisher information at the estimate.
+    let (params, refinement, cost_before, cost_after, information) = if options.refine {
+        let (r, h) = refine(samples, &active, &cf.params, &weights, options.use_profile);
+        (r.params, Some(r), r.cost_before, r.cost_after, h)
     } else {
-        let c = cost(samples, &active, &cf.params, &weights, options.use_profile);
-        (cf.params, None, c, c)
+        let ne = accumulate(samples, &active, &cf.params, &weights, options.use_profile);
+        (cf.params, None, ne.cost, ne.cost, ne.h)
     };
     if !params.to_vector().iter().all(|v| v.is_finite()) {
         return Err(SolveError::Numerical(format!(
@@ -243,15 +245,13 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
 
     // Motion classes with the estimated radii; for the "not excited" errors, where
     // the estimate is not trustworthy, with equal radii.
-    let motion = MotionContent::classify(samples, &active, params.r_l, params.r_r);
-    let motion_equal_radii = MotionContent::classify(samples, &active, 1.0, 1.0);
-    let information = accumulate(samples, &active, &params, &weights, options.use_profile).h;
+    let motion_equal_radii = || MotionContent::classify(samples, &active, 1.0, 1.0);
     let covariance = match invert_information(&information) {
         Inversion::Covariance(c) => *c,
         Inversion::Singular(null) => {
             return Err(information_not_excited(
                 null_direction_names(&null),
-                &motion,
+                &motion_equal_radii(),
             ))
         }
     };
@@ -262,8 +262,9 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         .map(|r| r.name.clone())
         .collect();
     if !not_excited.is_empty() {
-        return Err(information_not_excited(not_excited, &motion_equal_radii));
+        return Err(information_not_excited(not_excited, &motion_equal_radii()));
     }
+    let motion = MotionContent::classify(samples, &active, params.r_l, params.r_r);
     let observability = Observability {
         step1_condition: cf.step1.condition,
         a_condition: cf.step2.a_condition,

@@ -58,69 +58,152 @@ pub(crate) fn pieces(sample: &Sample, use_profile: bool) -> Pieces<'_> {
     }
 }
 
-/// Robot displacement `(x, y, θ)` (θ not wrapped) for wheel radii `r_l`, `r_r` and
-/// wheel distance `b` over the given pieces.
+/// `sin x`, `cos x`, `sin(x)/x` and `(1 − cos x)/x` from a single `sin_cos`.
+#[derive(Debug, Clone, Copy)]
+struct ArcTrig {
+    sin: f64,
+    cos: f64,
+    sin_over_x: f64,
+    one_minus_cos_over_x: f64,
+}
+
+impl ArcTrig {
+    #[inline]
+    fn new(x: f64) -> Self {
+        let (sin, cos) = x.sin_cos();
+        // Same switch as odocal-geom's functions, which handle small angles.
+        let (f, g) = if x.abs() < 1e-3 {
+            (sin_over_x(x), one_minus_cos_over_x(x))
+        } else {
+            (sin / x, (1.0 - cos) / x)
+        };
+        ArcTrig {
+            sin,
+            cos,
+            sin_over_x: f,
+            one_minus_cos_over_x: g,
+        }
+    }
+}
+
+/// A robot displacement with its heading unwrapped and the heading's sine and
+/// cosine (carried along so that callers need no further trigonometry).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct RawOdometry {
+    /// Forward displacement (m).
+    pub x: f64,
+    /// Lateral displacement (m).
+    pub y: f64,
+    /// Heading change (rad), not wrapped.
+    pub theta: f64,
+    /// `sin theta`.
+    pub sin: f64,
+    /// `cos theta`.
+    pub cos: f64,
+}
+
+impl RawOdometry {
+    /// `1 − cos theta` without cancellation for small angles.
+    #[inline]
+    pub(crate) fn one_minus_cos(&self) -> f64 {
+        if self.cos > 0.0 {
+            self.sin * self.sin / (1.0 + self.cos)
+        } else {
+            1.0 - self.cos
+        }
+    }
+
+    /// The same displacement with its translation scaled by `k`.
+    #[inline]
+    pub(crate) fn scale_translation(&self, k: f64) -> Self {
+        RawOdometry {
+            x: k * self.x,
+            y: k * self.y,
+            ..*self
+        }
+    }
+}
+
+/// Robot displacement for wheel radii `r_l`, `r_r` and wheel distance `b` over the
+/// given pieces. One `sin_cos` per piece; the heading's sine and cosine are
+/// propagated by the angle-addition formulas.
+#[inline]
 pub(crate) fn odometry_raw(
     r_l: f64,
     r_r: f64,
     b: f64,
     pieces: impl Iterator<Item = (f64, f64)>,
-) -> [f64; 3] {
-    let (mut x, mut y, mut th) = (0.0, 0.0, 0.0_f64);
+) -> RawOdometry {
+    let mut o = RawOdometry {
+        x: 0.0,
+        y: 0.0,
+        theta: 0.0,
+        sin: 0.0,
+        cos: 1.0,
+    };
     for (al, ar) in pieces {
         let ds = 0.5 * (r_l * al + r_r * ar);
         let dth = (r_r * ar - r_l * al) / b;
-        let dx = ds * sin_over_x(dth);
-        let dy = ds * one_minus_cos_over_x(dth);
-        if th == 0.0 {
-            x += dx;
-            y += dy;
-        } else {
-            let (s, c) = th.sin_cos();
-            x += c * dx - s * dy;
-            y += s * dx + c * dy;
-        }
-        th += dth;
+        let t = ArcTrig::new(dth);
+        let dx = ds * t.sin_over_x;
+        let dy = ds * t.one_minus_cos_over_x;
+        o.x += o.cos * dx - o.sin * dy;
+        o.y += o.sin * dx + o.cos * dy;
+        o.theta += dth;
+        (o.sin, o.cos) = (o.sin * t.cos + o.cos * t.sin, o.cos * t.cos - o.sin * t.sin);
     }
-    [x, y, th]
+    o
 }
 
-/// Robot displacement (θ not wrapped) and its derivative with respect to
-/// `(r_L, r_R, b)`: `d[row][param]`, rows x, y, θ.
+/// Robot displacement and its derivative with respect to `(r_L, r_R, b)`:
+/// `d[row][param]`, rows x, y, θ.
+#[inline]
 pub(crate) fn odometry_with_jacobian(
     r_l: f64,
     r_r: f64,
     b: f64,
     pieces: impl Iterator<Item = (f64, f64)>,
-) -> ([f64; 3], [[f64; 3]; 3]) {
-    let (mut x, mut y, mut th) = (0.0, 0.0, 0.0_f64);
+) -> (RawOdometry, [[f64; 3]; 3]) {
+    let mut o = RawOdometry {
+        x: 0.0,
+        y: 0.0,
+        theta: 0.0,
+        sin: 0.0,
+        cos: 1.0,
+    };
     let mut d = [[0.0; 3]; 3];
     for (al, ar) in pieces {
         let ds = 0.5 * (r_l * al + r_r * ar);
         let dth = (r_r * ar - r_l * al) / b;
         let d_ds = [0.5 * al, 0.5 * ar, 0.0];
         let d_dth = [-al / b, ar / b, -dth / b];
-        let (f, g) = (sin_over_x(dth), one_minus_cos_over_x(dth));
-        let (df, dg) = (d_sin_over_x(dth), d_one_minus_cos_over_x(dth));
+        let t = ArcTrig::new(dth);
+        let (f, g) = (t.sin_over_x, t.one_minus_cos_over_x);
+        let (df, dg) = if dth.abs() < SERIES_SWITCH {
+            (d_sin_over_x(dth), d_one_minus_cos_over_x(dth))
+        } else {
+            let x2 = dth * dth;
+            (
+                (dth * t.cos - t.sin) / x2,
+                (dth * t.sin - (1.0 - t.cos)) / x2,
+            )
+        };
         let (dx, dy) = (ds * f, ds * g);
-        let mut d_dx = [0.0; 3];
-        let mut d_dy = [0.0; 3];
+        let (s, c) = (o.sin, o.cos);
         for q in 0..3 {
-            d_dx[q] = d_ds[q] * f + ds * df * d_dth[q];
-            d_dy[q] = d_ds[q] * g + ds * dg * d_dth[q];
-        }
-        let (s, c) = th.sin_cos();
-        for q in 0..3 {
+            let d_dx = d_ds[q] * f + ds * df * d_dth[q];
+            let d_dy = d_ds[q] * g + ds * dg * d_dth[q];
             let dthq = d[2][q];
-            d[0][q] += (-s * dx - c * dy) * dthq + c * d_dx[q] - s * d_dy[q];
-            d[1][q] += (c * dx - s * dy) * dthq + s * d_dx[q] + c * d_dy[q];
+            d[0][q] += (-s * dx - c * dy) * dthq + c * d_dx - s * d_dy;
+            d[1][q] += (c * dx - s * dy) * dthq + s * d_dx + c * d_dy;
             d[2][q] += d_dth[q];
         }
-        x += c * dx - s * dy;
-        y += s * dx + c * dy;
-        th += dth;
+        o.x += c * dx - s * dy;
+        o.y += s * dx + c * dy;
+        o.theta += dth;
+        (o.sin, o.cos) = (s * t.cos + c * t.sin, c * t.cos - s * t.sin);
     }
-    ([x, y, th], d)
+    (o, d)
 }
 
 /// The robot's displacement `o` over the sample's interval, from the wheel
@@ -132,7 +215,7 @@ pub fn odometry(params: &Params, sample: &Sample, use_profile: bool) -> Pose2 {
         params.b,
         pieces(sample, use_profile),
     );
-    Pose2::new(o[0], o[1], o[2])
+    Pose2::new(o.x, o.y, o.theta)
 }
 
 /// Predicts sensor displacements `ŝ_pred = ⊖ℓ ⊕ o ⊕ ℓ` for fixed parameters, with
@@ -158,17 +241,19 @@ impl Predictor {
         }
     }
 
-    /// `ŝ_pred` as `[x, y, θ]` (θ wrapped) from the odometry `o` (θ unwrapped).
-    pub(crate) fn sensor_from_odometry(&self, o: [f64; 3]) -> [f64; 3] {
+    /// `ŝ_pred` as `[x, y, θ]` (θ wrapped) from the odometry `o`.
+    #[inline]
+    pub(crate) fn sensor_from_odometry(&self, o: &RawOdometry) -> [f64; 3] {
         let l = &self.params.laser;
-        let (sa, ca) = o[2].sin_cos();
+        let sa = o.sin;
         // v = t_o + (R(α) − I) t_ℓ, then ŝ_t = R(−ℓθ) v.
-        let vx = o[0] + (ca - 1.0) * l.x - sa * l.y;
-        let vy = o[1] + sa * l.x + (ca - 1.0) * l.y;
+        let omc = o.one_minus_cos();
+        let vx = o.x - omc * l.x - sa * l.y;
+        let vy = o.y + sa * l.x - omc * l.y;
         [
             self.cos_l * vx + self.sin_l * vy,
             -self.sin_l * vx + self.cos_l * vy,
-            wrap_angle(o[2]),
+            wrap_angle(o.theta),
         ]
     }
 
@@ -176,7 +261,7 @@ impl Predictor {
     pub fn predict(&self, sample: &Sample) -> [f64; 3] {
         let p = &self.params;
         let o = odometry_raw(p.r_l, p.r_r, p.b, pieces(sample, self.use_profile));
-        self.sensor_from_odometry(o)
+        self.sensor_from_odometry(&o)
     }
 
     /// `ŝ_pred − ŝ` for `sample` (angle wrapped).
@@ -195,8 +280,8 @@ impl Predictor {
         let p = &self.params;
         let l = &p.laser;
         let (o, d) = odometry_with_jacobian(p.r_l, p.r_r, p.b, pieces(sample, self.use_profile));
-        let s_pred = self.sensor_from_odometry(o);
-        let (sa, ca) = o[2].sin_cos();
+        let s_pred = self.sensor_from_odometry(&o);
+        let (sa, ca) = (o.sin, o.cos);
         let (c, s) = (self.cos_l, self.sin_l);
         // ∂(R(α) t_ℓ)/∂α
         let rot_x = -(sa * l.x + ca * l.y);
@@ -210,7 +295,8 @@ impl Predictor {
             g[2][q] = d[2][q];
         }
         // ∂ŝ_t/∂t_ℓ = R(−ℓθ)(R(α) − I)
-        let (m00, m01, m10, m11) = (ca - 1.0, -sa, sa, ca - 1.0);
+        let omc = o.one_minus_cos();
+        let (m00, m01, m10, m11) = (-omc, -sa, sa, -omc);
         g[0][3] = c * m00 + s * m10;
         g[0][4] = c * m01 + s * m11;
         g[1][3] = -s * m00 + c * m10;

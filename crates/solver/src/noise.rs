@@ -33,15 +33,6 @@ impl NoiseWeights {
             .collect::<Option<Vec<_>>>()
             .map(NoiseWeights::PerSample)
     }
-
-    /// The information matrix of sample `k`.
-    #[inline]
-    pub(crate) fn information(&self, k: usize) -> [[f64; 3]; 3] {
-        match self {
-            NoiseWeights::Shared(w) => [[w[0], 0.0, 0.0], [0.0, w[1], 0.0], [0.0, 0.0, w[2]]],
-            NoiseWeights::PerSample(v) => v[k],
-        }
-    }
 }
 
 /// Standard deviations (x, y, θ) of the residuals, mean removed, divided by `n − 1`

@@ -81,25 +81,3 @@ pub(crate) fn accumulate(
     }
     NormalEquations { cost, h, g }
 }
-
-/// The weighted cost `Σ eᵀWe` alone.
-pub(crate) fn cost(
-    samples: &[Sample],
-    active: &[usize],
-    params: &Params,
-    weights: &NoiseWeights,
-    use_profile: bool,
-) -> f64 {
-    let pred = Predictor::new(params, use_profile);
-    let mut total = 0.0;
-    for &k in active {
-        let e = pred.residual(&samples[k]);
-        let w = weights.information(k);
-        for r in 0..3 {
-            for c in 0..3 {
-                total += e[r] * w[r][c] * e[c];
-            }
-        }
-    }
-    total
-}

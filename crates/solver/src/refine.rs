@@ -30,14 +30,15 @@ pub struct Refinement {
     pub converged: bool,
 }
 
-/// Refines `start` over the samples `active`.
+/// Refines `start` over the samples `active`; also returns the Gauss–Newton matrix
+/// (Fisher information) at the refined parameters.
 pub(crate) fn refine(
     samples: &[Sample],
     active: &[usize],
     start: &Params,
     weights: &NoiseWeights,
     use_profile: bool,
-) -> Refinement {
+) -> (Refinement, [[f64; 6]; 6]) {
     let mut params = *start;
     let mut ne = accumulate(samples, active, &params, weights, use_profile);
     let cost_before = ne.cost;
@@ -93,11 +94,14 @@ pub(crate) fn refine(
         }
     }
     let cost_after = ne.cost;
-    Refinement {
-        params,
-        cost_before,
-        cost_after,
-        iterations,
-        converged,
-    }
+    (
+        Refinement {
+            params,
+            cost_before,
+            cost_after,
+            iterations,
+            converged,
+        },
+        ne.h,
+    )
 }

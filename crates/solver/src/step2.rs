@@ -2,7 +2,7 @@
 //! minimising `xᵀMx` over `x = [b, ℓx, ℓy, cos ℓθ, sin ℓθ]` with `x4² + x5² = 1`
 //! through the Schur complement of the 3×3 block `A` of `M`.
 
-use crate::kinematics::{odometry_raw, pieces};
+use crate::kinematics::{odometry_raw, pieces, RawOdometry};
 use crate::linalg::{
     condition_from_eigenvalues, symmetric_eigen2, symmetric_eigen_sorted, unit_diagonal,
 };
@@ -30,39 +30,30 @@ pub struct Step2 {
     pub residual: f64,
 }
 
-/// Per-sample odometry for `b = 1`: `c_x`, `c_y` and `oθ` (unwrapped), so that the
-/// robot displacement is `(b·c_x, b·c_y, oθ)`.
-pub type UnitOdometry = [f64; 3];
-
 /// Scaled condition number of `A` above which `b`, `ℓx`, `ℓy` are treated as not
 /// excited by step 2 (the Schur solution would be numerically meaningless).
 pub const A_SINGULAR_CONDITION: f64 = 1e12;
 
 /// Builds `M` over `active` for the given `J21`, `J22` and returns it with the
-/// per-sample unit odometry (same order as `active`).
-pub fn build_m(
+/// per-sample odometry for `b = 1` (`c_x`, `c_y`, `oθ`; same order as `active`), so
+/// that the robot displacement is `(b·c_x, b·c_y, oθ)`.
+pub(crate) fn build_m(
     samples: &[Sample],
     active: &[usize],
     j21: f64,
     j22: f64,
     use_profile: bool,
-) -> ([[f64; 5]; 5], Vec<UnitOdometry>) {
+) -> ([[f64; 5]; 5], Vec<RawOdometry>) {
     let mut m = [[0.0; 5]; 5];
     let mut unit = Vec::with_capacity(active.len());
     for &k in active {
         let s = &samples[k];
         let o = odometry_raw(-j21, j22, 1.0, pieces(s, use_profile));
         unit.push(o);
-        let (sn, cs) = o[2].sin_cos();
-        // 1 − cos without cancellation for small angles.
-        let omc = if o[2].abs() < 0.5 {
-            sn * sn / (1.0 + cs)
-        } else {
-            1.0 - cs
-        };
+        let (sn, omc) = (o.sin, o.one_minus_cos());
         let (sx, sy) = (s.sm.x, s.sm.y);
-        let r1 = [-o[0], omc, sn, sx, -sy];
-        let r2 = [-o[1], -sn, omc, sy, sx];
+        let r1 = [-o.x, omc, sn, sx, -sy];
+        let r2 = [-o.y, -sn, omc, sy, sx];
         for i in 0..5 {
             for j in i..5 {
                 m[i][j] += r1[i] * r1[j] + r2[i] * r2[j];

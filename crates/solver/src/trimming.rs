@@ -69,7 +69,11 @@ pub fn tro_keep(residuals: &[[f64; 3]], p: f64) -> Vec<bool> {
         return Vec::new();
     }
     let index = (((1.0 - p) * n as f64).round() as usize).min(n - 1);
-    let xy: Vec<f64> = residuals.iter().map(|e| e[0].hypot(e[1])).collect();
+    // Squared |e_xy|: same order, no square root.
+    let xy: Vec<f64> = residuals
+        .iter()
+        .map(|e| e[0] * e[0] + e[1] * e[1])
+        .collect();
     let th: Vec<f64> = residuals.iter().map(|e| e[2].abs()).collect();
     let t_xy = order_statistic(&mut xy.clone(), index);
     let t_th = order_statistic(&mut th.clone(), index);
