@@ -24,75 +24,68 @@ pub(crate) fn nearest_by_angle(
     guess: usize,
     max_dist2: f64,
 ) -> Option<usize> {
-    let n = reference.dirs.len();
-    let dirs = &reference.dirs;
-    let cross = |k: usize| dirs[k][0] * p[1] - dirs[k][1] * p[0];
-    let dot = |k: usize| dirs[k][0] * p[0] + dirs[k][1] * p[1];
+    let rays = &reference.rays[..];
+    let n = rays.len();
+    // cross > 0: p is counter-clockwise of the ray; dot > 0: p is in front of it.
+    let cross = |d: [f64; 2]| d[0] * p[1] - d[1] * p[0];
+    let dot = |d: [f64; 2]| d[0] * p[0] + d[1] * p[1];
     let r2 = p[0] * p[0] + p[1] * p[1];
 
     let mut j = guess.min(n - 1);
-    if dot(j) <= 0.0 {
+    if dot(rays[j].dir) <= 0.0 {
         // The guess points away from p: restart from p's bearing.
         j = reference.ray_near_bearing(p[1].atan2(p[0]));
     }
-    // Walk to the pair of rays (lo, lo+1) that brackets p's bearing.
-    let mut lo;
-    if cross(j) > 0.0 {
-        // p is counter-clockwise of ray j.
-        while j + 1 < n && cross(j + 1) > 0.0 && dot(j + 1) > 0.0 {
+    // Walk to the pair of rays (lo, lo + 1) that brackets p's bearing.
+    let lo: isize = if cross(rays[j].dir) > 0.0 {
+        while j + 1 < n && cross(rays[j + 1].dir) > 0.0 && dot(rays[j + 1].dir) > 0.0 {
             j += 1;
         }
-        lo = j as isize;
+        j as isize
     } else {
-        while j > 0 && cross(j - 1) <= 0.0 && dot(j - 1) > 0.0 {
+        while j > 0 && cross(rays[j - 1].dir) <= 0.0 && dot(rays[j - 1].dir) > 0.0 {
             j -= 1;
         }
-        lo = j as isize - 1;
-    }
-    let mut best = max_dist2;
-    let mut best_j = None;
-    let points = &reference.points;
-    let valid = &reference.valid;
-    let lower_bound = |k: usize| {
-        if dot(k) > 0.0 {
-            let s = cross(k);
-            s * s
+        j as isize - 1
+    };
+    // Lower bound of the squared distance from p to any point on ray k: the squared
+    // distance to the ray's half-line. It grows as the rays turn away from p.
+    let lower_bound = |d: [f64; 2]| {
+        let c = cross(d);
+        if dot(d) > 0.0 {
+            c * c
         } else {
             r2
         }
     };
-    let lo_start = lo;
-    // Clockwise from lo.
-    while lo >= 0 {
-        let k = lo as usize;
-        if lower_bound(k) >= best {
+    let mut best = max_dist2;
+    let mut best_k = usize::MAX;
+    // Clockwise from lo, then counter-clockwise from lo + 1. Invalid points are NaN,
+    // whose distance never compares smaller.
+    let mut visit = |k: usize| {
+        let ray = rays[k];
+        if lower_bound(ray.dir) >= best {
+            return false;
+        }
+        let d2 = dist2(ray.point, p);
+        if d2 < best {
+            best = d2;
+            best_k = k;
+        }
+        true
+    };
+    let first_ccw = (lo + 1) as usize;
+    for k in (0..first_ccw).rev() {
+        if !visit(k) {
             break;
         }
-        if valid[k] {
-            let d2 = dist2(points[k], p);
-            if d2 < best {
-                best = d2;
-                best_j = Some(k);
-            }
-        }
-        lo -= 1;
     }
-    // Counter-clockwise from lo + 1.
-    let mut k = (lo_start + 1) as usize;
-    while k < n {
-        if lower_bound(k) >= best {
+    for k in first_ccw..n {
+        if !visit(k) {
             break;
         }
-        if valid[k] {
-            let d2 = dist2(points[k], p);
-            if d2 < best {
-                best = d2;
-                best_j = Some(k);
-            }
-        }
-        k += 1;
     }
-    best_j
+    (best_k != usize::MAX).then_some(best_k)
 }
 
 /// Closest valid reference point to `p` within `sqrt(max_dist2)`, by the k-d tree.
@@ -109,10 +102,11 @@ pub(crate) fn segment_for(reference: &PreparedScan, p: [f64; 2], j: usize) -> Op
     let pts = &reference.points;
     let pj = pts[j];
     let e = [p[0] - pj[0], p[1] - pj[1]];
-    // Projection parameter of p along the segment from j towards `other` (0 at j).
+    // Projection of p along the segment from j towards `other`, as (e·v, |v|²): the
+    // parameter is their ratio (0 at j, 1 at `other`).
     let along = |other: usize| {
         let v = [pts[other][0] - pj[0], pts[other][1] - pj[1]];
-        (e[0] * v[0] + e[1] * v[1]) / (v[0] * v[0] + v[1] * v[1])
+        (e[0] * v[0] + e[1] * v[1], v[0] * v[0] + v[1] * v[1])
     };
     let forward = reference.segments[j].map(|_| along(j + 1));
     let backward = if j > 0 {
@@ -121,11 +115,17 @@ pub(crate) fn segment_for(reference: &PreparedScan, p: [f64; 2], j: usize) -> Op
         None
     };
     match (forward, backward) {
-        (Some(f), Some(b)) if f >= b && f >= 0.0 => Some(j),
-        (Some(_), Some(b)) if b >= 0.0 => Some(j - 1),
-        (Some(f), None) if f >= 0.0 => Some(j),
-        (None, Some(b)) if b >= 0.0 => Some(j - 1),
-        _ => None,
+        // Both sides: the one with the larger parameter f/lf ≥ b/lb (lengths > 0).
+        (Some((f, lf)), Some((b, lb))) => {
+            if f * lb >= b * lf {
+                (f >= 0.0).then_some(j)
+            } else {
+                (b >= 0.0).then(|| j - 1)
+            }
+        }
+        (Some((f, _)), None) => (f >= 0.0).then_some(j),
+        (None, Some((b, _))) => (b >= 0.0).then(|| j - 1),
+        (None, None) => None,
     }
 }
 

@@ -3,8 +3,9 @@
 //! At the solution, each used correspondence contributes the row
 //! `J_i = [n_x, n_y, n_iᵀ R'(θ) q_i]` (derivative of its residual with respect to
 //! `(x, y, θ)`), and the information matrix is `I = Σ J_iᵀ J_i` — the Gauss–Newton
-//! Hessian of the point-to-line cost. The covariance is `σ̂² I⁻¹`, with
-//! `σ̂² = Σ e_i² / (m − 3)` the residual variance. This is the first-order estimate
+//! Hessian of the point-to-line cost. With the weights `w_i` of the step
+//! (inverse residual variances up to a common factor σ̂²), `I = Σ w_i J_iᵀ J_i` and the
+//! covariance is `σ̂² I⁻¹`, `σ̂² = Σ w_i e_i² / (m − 3)`. This is the first-order estimate
 //! for independent residuals; it does not propagate the noise of the reference
 //! points through the local lines (Censi's ICRA 2007 closed form does), and it is
 //! optimistic when the range noise is correlated along the scan (see
@@ -51,8 +52,9 @@ impl InformationSum {
         }
     }
 
-    /// Adds a used correspondence: current point `q`, reference line normal, residual.
-    pub fn add(&mut self, q: [f64; 2], normal: [f64; 2], residual: f64) {
+    /// Adds a used correspondence: current point `q`, reference line normal, residual
+    /// and weight (inverse residual variance up to the common factor σ̂²).
+    pub fn add(&mut self, q: [f64; 2], normal: [f64; 2], residual: f64, w: f64) {
         let (s, c) = (self.sin, self.cos);
         let dq = [-s * q[0] - c * q[1], c * q[0] - s * q[1]];
         let j = nalgebra::Vector3::new(
@@ -60,8 +62,8 @@ impl InformationSum {
             normal[1],
             normal[0] * dq[0] + normal[1] * dq[1],
         );
-        self.info += j * j.transpose();
-        self.sum_sq += residual * residual;
+        self.info += (w * j) * j.transpose();
+        self.sum_sq += w * residual * residual;
         self.sum_r2 += q[0] * q[0] + q[1] * q[1];
         self.count += 1;
     }

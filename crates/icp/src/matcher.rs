@@ -40,9 +40,16 @@ struct Correspondence {
     /// Reference line.
     normal: [f64; 2],
     offset: f64,
-    /// Signed point-to-line distance at the estimate of this iteration.
-    residual: f64,
+    /// Weight (inverse residual variance up to a common factor).
+    weight: f64,
+    /// `residual² · weight`: what the trimming compares (squared).
+    normalized_sq: f64,
+    /// Index of the current point and of the reference segment (for cycle detection).
+    key: u64,
 }
+
+/// Number of past correspondence sets remembered to detect a cycle.
+const CYCLE_MEMORY: usize = 8;
 
 /// Point-to-line ICP with its scratch buffers (reused: no allocation per iteration
 /// once warmed up). Use one per thread.
@@ -50,7 +57,7 @@ struct Correspondence {
 pub struct Matcher {
     params: IcpParams,
     correspondences: Vec<Correspondence>,
-    abs_residuals: Vec<f64>,
+    squared_residuals: Vec<f64>,
     /// Per valid current point: the reference ray where the last search ended.
     search_start: Vec<u32>,
 }
@@ -61,7 +68,7 @@ impl Matcher {
         Matcher {
             params,
             correspondences: Vec::new(),
-            abs_residuals: Vec::new(),
+            squared_residuals: Vec::new(),
             search_start: Vec::new(),
         }
     }
@@ -110,6 +117,10 @@ impl Matcher {
         let mut iterations = 0;
         let mut converged = false;
         let mut last_step = (f64::INFINITY, f64::INFINITY);
+        // Fingerprints of the sets of used correspondences of the last iterations.
+        let mut history = [0u64; CYCLE_MEMORY];
+        // Set after a first cycle: the threshold then follows the residual spread only.
+        let mut motion_term_dropped = false;
         while iterations < params.max_iterations {
             iterations += 1;
             self.find_correspondences(reference, current, &estimate, gate2, use_tree);
@@ -121,16 +132,25 @@ impl Matcher {
                     iteration: iterations,
                 });
             }
-            self.abs_residuals.clear();
-            self.abs_residuals
-                .extend(self.correspondences.iter().map(|c| c.residual.abs()));
-            tau = threshold(&mut self.abs_residuals, &params, previous_motion, tau);
+            self.squared_residuals.clear();
+            self.squared_residuals
+                .extend(self.correspondences.iter().map(|c| c.normalized_sq));
+            let motion = if motion_term_dropped {
+                Some(0.0)
+            } else {
+                previous_motion
+            };
+            let motion_limited;
+            (tau, motion_limited) = threshold(&mut self.squared_residuals, &params, motion, tau);
+            let tau_sq = tau * tau;
 
             let mut equations = NormalEquations::new();
             let mut used = 0;
-            for c in self.correspondences.iter().filter(|c| c.residual.abs() <= tau) {
-                equations.add(c.q, c.normal, c.offset);
+            let mut fingerprint = 0xcbf2_9ce4_8422_2325u64;
+            for c in self.correspondences.iter().filter(|c| c.normalized_sq <= tau_sq) {
+                equations.add(c.q, c.normal, c.offset, c.weight);
                 used += 1;
+                fingerprint = (fingerprint ^ c.key).wrapping_mul(0x0000_0100_0000_01b3);
             }
             if used < params.min_correspondences {
                 return Err(IcpError::TooFewCorrespondences {
@@ -147,9 +167,35 @@ impl Matcher {
             let step_xy = step.translation_norm();
             let step_theta = step.theta.abs();
             last_step = (step_xy, step_theta);
+            if std::env::var("ICP_DEBUG").is_ok() { eprintln!("it {iterations} found {found} used {used} tau {tau:.2e} step {step_xy:.2e} {step_theta:.2e} est {next}"); }
             estimate = next;
             previous_motion = Some(step_xy + rho_max * step_theta);
-            if step_xy <= params.epsilon_xy && step_theta <= params.epsilon_theta {
+            if step_xy <= params.epsilon_xy && step_theta <= params.epsilon_theta && !motion_limited {
+                converged = true;
+                break;
+            }
+            // The same correspondences as a few iterations ago: the iterations cycle
+            // (the weights depend on the correspondences only, so the same set gives
+            // the same solution). A first cycle is broken by letting the threshold
+            // drop to the residual spread — on exact data that removes the last
+            // imperfect matches near corners; a cycle after that is noise flipping
+            // matches between nearly equivalent segments, and another turn would only
+            // repeat it.
+            let slot = iterations as usize % CYCLE_MEMORY;
+            if history.contains(&fingerprint) {
+                if motion_term_dropped {
+                    converged = true;
+                    break;
+                }
+                motion_term_dropped = true;
+                history = [0; CYCLE_MEMORY];
+            }
+            history[slot] = fingerprint;
+            // Longer or irregular flipping: accept once the steps are negligible.
+            if iterations >= params.settle_after
+                && step_xy <= params.settle_xy
+                && step_theta <= params.settle_theta
+            {
                 converged = true;
                 break;
             }
@@ -180,17 +226,18 @@ impl Matcher {
         }
 
         // Uncertainty at the final estimate, over the correspondences used last.
+        let tau_sq = tau * tau;
         let mut info = InformationSum::new(&estimate);
         let (s, c) = estimate.theta.sin_cos();
         let mut sum_abs = 0.0;
-        for k in self.correspondences.iter().filter(|k| k.residual.abs() <= tau) {
+        for k in self.correspondences.iter().filter(|k| k.normalized_sq <= tau_sq) {
             let p = [
                 estimate.x + c * k.q[0] - s * k.q[1],
                 estimate.y + s * k.q[0] + c * k.q[1],
             ];
             let e = k.normal[0] * p[0] + k.normal[1] * p[1] - k.offset;
             sum_abs += e.abs();
-            info.add(k.q, k.normal, e);
+            info.add(k.q, k.normal, e, k.weight);
         }
         let used = info.count();
         let unc = info.finish().ok_or(IcpError::Numerical {
@@ -241,11 +288,26 @@ impl Matcher {
                 continue;
             };
             let residual = line.normal[0] * p[0] + line.normal[1] * p[1] - line.offset;
+            let weight = if self.params.incidence_weighting {
+                // Incidence of the current ray on its own surface (a property of the
+                // current scan alone, so that a correspondence's weight never depends
+                // on the estimate), or of the reference rays when unknown.
+                let own = current.incidence_cos[i as usize];
+                let cos_cur = if own.is_nan() { line.incidence_cos } else { own };
+                let floor = self.params.min_incidence_cos;
+                1.0 / (cos_cur * cos_cur
+                    + self.params.reference_noise_share * line.incidence_cos * line.incidence_cos
+                    + floor * floor)
+            } else {
+                1.0
+            };
             self.correspondences.push(Correspondence {
                 q,
                 normal: line.normal,
                 offset: line.offset,
-                residual,
+                weight,
+                normalized_sq: residual * residual * weight,
+                key: ((k as u64) << 32) | seg as u64,
             });
         }
     }

@@ -23,6 +23,14 @@ pub struct IcpParams {
     pub epsilon_xy: f64,
     /// … and turns it by less than this (rad).
     pub epsilon_theta: f64,
+    /// From this iteration on, a step below `settle_xy` and `settle_theta` also ends the
+    /// iterations: on noisy scans a few matches may keep flipping between nearly
+    /// equivalent segments, moving the estimate back and forth by micrometres.
+    pub settle_after: u32,
+    /// See [`IcpParams::settle_after`] (m).
+    pub settle_xy: f64,
+    /// See [`IcpParams::settle_after`] (rad).
+    pub settle_theta: f64,
     /// A current point farther than this from every reference point gets no match (m).
     pub max_correspondence_dist: f64,
     /// At most this fraction of the matches (the ones with the smallest residuals) is
@@ -61,17 +69,31 @@ pub struct IcpParams {
     pub max_condition_number: f64,
     /// Closest-point search method.
     pub search: NeighbourSearch,
+    /// Weight correspondences by the inverse variance of their residual under range
+    /// noise: `1 / (cos²α_cur + reference_noise_share · cos²α_ref + min_incidence_cos²)`,
+    /// α being the incidence angles of the current ray and of the reference rays on the
+    /// line (range noise moves a point along its ray, so only `cos α` of it shows in a
+    /// point-to-line distance).
+    pub incidence_weighting: bool,
+    /// Share of the reference points' noise left in a local line (≈ 1 / effective
+    /// number of independent points in the fitting window).
+    pub reference_noise_share: f64,
+    /// Floor of `cos α` in the weights, bounding the weight of grazing rays.
+    pub min_incidence_cos: f64,
 }
 
 impl Default for IcpParams {
     fn default() -> Self {
         IcpParams {
             max_iterations: 40,
-            epsilon_xy: 1e-8,
-            epsilon_theta: 1e-9,
+            epsilon_xy: 1e-6,
+            epsilon_theta: 1e-7,
+            settle_after: 12,
+            settle_xy: 5e-5,
+            settle_theta: 5e-5,
             max_correspondence_dist: 0.3,
-            trim_fraction: 0.95,
-            outlier_sigma_mult: 3.0,
+            trim_fraction: 1.0,
+            outlier_sigma_mult: 4.0,
             step_threshold_mult: 3.0,
             min_reading: 0.02,
             max_reading: 4.0,
@@ -83,8 +105,11 @@ impl Default for IcpParams {
             discontinuity_gap_factor: 10.0,
             min_valid_points: 20,
             min_correspondences: 20,
-            max_condition_number: 1e3,
+            max_condition_number: 50.0,
             search: NeighbourSearch::Angular,
+            incidence_weighting: true,
+            reference_noise_share: 0.5,
+            min_incidence_cos: 0.2,
         }
     }
 }
@@ -101,6 +126,11 @@ impl IcpParams {
             || !(self.epsilon_theta.is_finite() && self.epsilon_theta >= 0.0)
         {
             return bad("epsilon_xy and epsilon_theta must be finite and non-negative");
+        }
+        if !(self.settle_xy.is_finite() && self.settle_xy >= 0.0)
+            || !(self.settle_theta.is_finite() && self.settle_theta >= 0.0)
+        {
+            return bad("settle_xy and settle_theta must be finite and non-negative");
         }
         if !positive(self.max_correspondence_dist) {
             return bad("max_correspondence_dist must be positive");
@@ -134,6 +164,12 @@ impl IcpParams {
         }
         if !positive(self.max_condition_number) {
             return bad("max_condition_number must be positive");
+        }
+        if !(self.reference_noise_share.is_finite() && self.reference_noise_share >= 0.0) {
+            return bad("reference_noise_share must be finite and non-negative");
+        }
+        if !(self.min_incidence_cos > 0.0 && self.min_incidence_cos <= 1.0) {
+            return bad("min_incidence_cos must be in (0, 1]");
         }
         Ok(())
     }

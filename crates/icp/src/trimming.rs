@@ -18,40 +18,44 @@ use crate::IcpParams;
 /// Consistency constant of the median absolute deviation for a Gaussian.
 const MAD_TO_SIGMA: f64 = 1.482_602_218_505_602;
 
-/// The threshold for this iteration; `abs_residuals` is used as scratch (reordered).
+/// The threshold for this iteration, given the *squared* (normalised) residuals;
+/// `squared_residuals` is used as scratch (reordered). Returns τ (not squared) and
+/// whether the motion term raised it above what the residual spread alone gives (then
+/// the next iteration, with a smaller motion, will use a smaller τ).
 pub(crate) fn threshold(
-    abs_residuals: &mut [f64],
+    squared_residuals: &mut [f64],
     params: &IcpParams,
     previous_motion: Option<f64>,
     previous_threshold: f64,
-) -> f64 {
-    let m = abs_residuals.len();
+) -> (f64, bool) {
+    let m = squared_residuals.len();
     if m == 0 {
-        return 0.0;
+        return (0.0, false);
     }
     let mid = m / 2;
-    let (_, median, upper) = abs_residuals.select_nth_unstable_by(mid, f64::total_cmp);
-    let sigma = MAD_TO_SIGMA * *median;
+    let (_, median_sq, upper) = squared_residuals.select_nth_unstable_by(mid, f64::total_cmp);
+    let median = median_sq.sqrt();
+    let sigma = MAD_TO_SIGMA * median;
     let step_term = match previous_motion {
         Some(motion) => params.step_threshold_mult * motion,
         None => params.max_correspondence_dist,
     };
-    let mut tau = (params.outlier_sigma_mult * sigma)
-        .max(step_term)
-        .min(previous_threshold);
+    let noise_term = params.outlier_sigma_mult * sigma;
+    let motion_limited = step_term > noise_term && noise_term < previous_threshold;
+    let mut tau = noise_term.max(step_term).min(previous_threshold);
     if params.trim_fraction < 1.0 {
         // Keep the ⌈q·m⌉ smallest residuals at most.
         let keep = ((params.trim_fraction * m as f64).ceil() as usize).clamp(1, m);
         let q_index = keep - 1;
         let quantile = if q_index <= mid {
-            *median
+            median
         } else {
             let (_, q, _) = upper.select_nth_unstable_by(q_index - mid - 1, f64::total_cmp);
-            *q
+            q.sqrt()
         };
         tau = tau.min(quantile);
     }
-    tau
+    (tau, motion_limited)
 }
 
 #[cfg(test)]
@@ -63,9 +67,9 @@ mod tests {
         let mut params = IcpParams::default();
         params.trim_fraction = 1.0;
         // 90 inliers spread ~1 mm, 10 outliers at 5 cm.
-        let mut r: Vec<f64> = (0..90).map(|i| 0.001 * ((i % 9) as f64 / 4.0)).collect();
-        r.extend(std::iter::repeat_n(0.05, 10));
-        let tau = threshold(&mut r.clone(), &params, Some(1e-6), f64::INFINITY);
+        let mut r: Vec<f64> = (0..90).map(|i| (0.001 * ((i % 9) as f64 / 4.0)).powi(2)).collect();
+        r.extend(std::iter::repeat_n(0.05f64.powi(2), 10));
+        let (tau, _) = threshold(&mut r.clone(), &params, Some(1e-6), f64::INFINITY);
         assert!(tau > 0.002 && tau < 0.05, "tau = {tau}");
     }
 
@@ -73,12 +77,12 @@ mod tests {
     fn fraction_and_monotonicity() {
         let mut params = IcpParams::default();
         params.trim_fraction = 0.9;
-        let r: Vec<f64> = (1..=100).map(|i| i as f64 * 1e-3).collect();
+        let r: Vec<f64> = (1..=100).map(|i| (i as f64 * 1e-3).powi(2)).collect();
         // A large motion would allow everything; the fraction keeps 90 of 100.
-        let tau = threshold(&mut r.clone(), &params, Some(1.0), f64::INFINITY);
-        assert_eq!(tau, 0.090);
+        let (tau, _) = threshold(&mut r.clone(), &params, Some(1.0), f64::INFINITY);
+        assert!((tau - 0.090).abs() < 1e-15);
         // Never above the previous threshold.
-        let tau = threshold(&mut r.clone(), &params, Some(1.0), 0.01);
+        let (tau, _) = threshold(&mut r.clone(), &params, Some(1.0), 0.01);
         assert_eq!(tau, 0.01);
     }
 }
