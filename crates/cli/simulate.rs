@@ -35,13 +35,13 @@ pub struct Args {
     print_config: bool,
 
     /// True left wheel radius (m).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     r_l: Option<f64>,
     /// True right wheel radius (m).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     r_r: Option<f64>,
     /// True wheel distance (m).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     b: Option<f64>,
     /// True laser x in the robot frame (m).
     #[arg(long, allow_hyphen_values = true)]
@@ -59,7 +59,7 @@ pub struct Args {
     #[arg(long)]
     modulus: Option<u64>,
     /// Encoder counts at the start, left and right (e.g. 65000,12).
-    #[arg(long, value_delimiter = ',', num_args = 2, allow_hyphen_values = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     initial_ticks: Option<Vec<i64>>,
     /// Encoder records per second.
     #[arg(long)]
@@ -215,7 +215,10 @@ fn apply_overrides(c: &mut SimConfig, a: &Args) -> anyhow::Result<()> {
         c.encoder.modulus = a.modulus;
     }
     if let Some(t) = &a.initial_ticks {
-        c.encoder.initial_ticks = [t[0], t[1]];
+        let [l, r] = t[..] else {
+            anyhow::bail!("--initial-ticks takes two counts, LEFT,RIGHT (got {t:?})");
+        };
+        c.encoder.initial_ticks = [l, r];
     }
     set(&mut c.encoder.rate_hz, a.encoder_rate);
     set(&mut c.encoder.jitter_s, a.encoder_jitter);
@@ -274,4 +277,83 @@ fn command_line() -> String {
         }
     }));
     parts.join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Wrapper {
+        #[command(flatten)]
+        args: Args,
+    }
+
+    fn parse(cmd: &str) -> Args {
+        Wrapper::try_parse_from(std::iter::once("simulate").chain(cmd.split_whitespace()))
+            .unwrap()
+            .args
+    }
+
+    #[test]
+    fn overrides_reach_the_configuration() {
+        let a = parse(
+            "--preset khepera --seed 9 --duration 12 --out x --r-l 0.03 --r-r 0.031 --b 0.2 \
+             --laser-x -0.1 --laser-y 0.05 --laser-theta -1.5 --ticks-per-rev 4096 \
+             --modulus 65536 --initial-ticks 65000,-5 --encoder-rate 100 --scan-rate 5 \
+             --world office --trajectory spin-only --range-noise 0.01 --clock-offset -0.02 \
+             --slip 3 --drop 0.1 --garbage 0.01 --no-odom",
+        );
+        let mut c = PresetRegistry::builtin().get(&a.preset).unwrap();
+        apply_overrides(&mut c, &a).unwrap();
+        c.validate().unwrap();
+        assert_eq!((c.seed, c.duration), (9, 12.0));
+        assert_eq!((c.robot.r_l, c.robot.r_r, c.robot.b), (0.03, 0.031, 0.2));
+        assert_eq!(c.robot.laser, Pose2::new(-0.1, 0.05, -1.5));
+        assert_eq!(c.encoder.ticks_per_revolution, 4096.0);
+        assert_eq!(c.encoder.modulus, Some(65536));
+        assert_eq!(c.encoder.initial_ticks, [65000, -5]);
+        assert_eq!((c.encoder.rate_hz, c.laser.rate_hz), (100.0, 5.0));
+        assert_eq!(c.world, "office");
+        assert_eq!(c.trajectory, TrajectoryKind::SpinOnly);
+        assert_eq!(c.laser.range_sigma, 0.01);
+        assert_eq!(c.faults.clock_offset, -0.02);
+        assert_eq!(
+            (
+                c.faults.slip_per_minute,
+                c.faults.drop_fraction,
+                c.faults.garbage_fraction
+            ),
+            (3.0, 0.1, 0.01)
+        );
+        assert!(!c.write_odom);
+    }
+
+    #[test]
+    fn bad_names_and_values_are_errors() {
+        let mut c = SimConfig::default();
+        assert!(apply_overrides(&mut c, &parse("--out x --world moon")).is_err());
+        let mut c = SimConfig::default();
+        assert!(apply_overrides(&mut c, &parse("--out x --trajectory loops")).is_err());
+        let mut c = SimConfig::default();
+        assert!(apply_overrides(&mut c, &parse("--out x --initial-ticks 5")).is_err());
+        let mut c = SimConfig::default();
+        apply_overrides(&mut c, &parse("--out x --b -1")).unwrap();
+        assert!(c.validate().is_err());
+        assert!(PresetRegistry::builtin().get("k99").is_err());
+    }
+
+    #[test]
+    fn noise_free_clears_every_error_source() {
+        let mut c = SimConfig::default();
+        apply_overrides(&mut c, &parse("--out x --noise-free")).unwrap();
+        assert_eq!(c.laser.range_sigma, 0.0);
+        assert_eq!(c.laser.quantization, 0.0);
+        assert_eq!(c.laser.dropout_probability, 0.0);
+        assert_eq!(
+            with_suffix(Path::new("a/run.v2"), ".log"),
+            Path::new("a/run.v2.log")
+        );
+    }
 }
