@@ -3,20 +3,20 @@
 
 use crate::covariance::{invert_information, Inversion};
 use crate::error::SolveError;
-use crate::kinematics::Predictor;
+use crate::kinematics::{residual_of, Predictor};
 use crate::noise::{residual_sigmas, NoiseWeights};
 use crate::normal_equations::accumulate;
 use crate::observability::{
     information_not_excited, null_direction_names, parameter_reports, sentence, step1_not_excited,
     step2_not_excited, wheel_signs, MotionContent, Observability, Verdict,
 };
+use crate::packed::Packed;
 use crate::params::Params;
 use crate::refine::{refine, Refinement};
 use crate::sample::Sample;
 use crate::step1::{step1, Step1};
 use crate::step2::{build_m, solve_m, Step2, A_SINGULAR_CONDITION};
 use crate::trimming::Trim;
-use odocal_geom::wrap_angle;
 use serde::{Deserialize, Serialize};
 
 /// Fewest samples the solver accepts (input and after each trimming round).
@@ -106,33 +106,39 @@ pub struct Calibration {
     pub observability: Observability,
 }
 
-/// Closed form (step 1 and step 2) on `active`, or the "not excited" error.
-pub fn closed_form(
-    samples: &[Sample],
-    active: &[usize],
+/// Closed form (step 1 and step 2) on all `samples`, without trimming: the
+/// papers' estimate, or the "not excited" error.
+pub fn closed_form(samples: &[Sample], use_profile: bool) -> Result<ClosedForm, SolveError> {
+    for (k, s) in samples.iter().enumerate() {
+        s.check(k)?;
+    }
+    closed_form_packed(&Packed::all(samples, use_profile), None).map(|(cf, _)| cf)
+}
+
+/// Closed form on packed samples; also returns the residuals `ŝ_pred − ŝ`.
+fn closed_form_packed(
+    samples: &[Packed],
     theta_weights: Option<&[f64]>,
-    use_profile: bool,
 ) -> Result<(ClosedForm, Vec<[f64; 3]>), SolveError> {
-    let s1 = step1(samples, active, theta_weights);
+    let s1 = step1(samples, theta_weights);
     if s1.condition.is_nan()
         || s1.condition > STEP1_SINGULAR_CONDITION
         || !s1.j21.is_finite()
         || !s1.j22.is_finite()
     {
-        return Err(step1_not_excited(samples, active, &s1));
+        return Err(step1_not_excited(samples, &s1));
     }
-    let (m, unit) = build_m(samples, active, s1.j21, s1.j22, use_profile);
+    let (m, unit) = build_m(samples, s1.j21, s1.j22);
     let s2 = match solve_m(&m) {
         Some(s2) if s2.a_condition_scaled <= A_SINGULAR_CONDITION && s2.b > 0.0 => s2,
         Some(s2) => {
             return Err(step2_not_excited(
                 samples,
-                active,
                 &s1,
                 Some(s2.a_weakest_direction),
             ))
         }
-        None => return Err(step2_not_excited(samples, active, &s1, None)),
+        None => return Err(step2_not_excited(samples, &s1, None)),
     };
     let params = Params {
         r_l: -s2.b * s1.j21,
@@ -141,15 +147,11 @@ pub fn closed_form(
         laser: s2.laser,
     };
     // Residuals ŝ_pred − ŝ from the cached unit odometry: o = (b·c_x, b·c_y, oθ).
-    let pred = Predictor::new(&params, use_profile);
-    let residuals = active
+    let pred = Predictor::new(&params, true);
+    let residuals = samples
         .iter()
         .zip(&unit)
-        .map(|(&k, u)| {
-            let p = pred.sensor_from_odometry(&u.scale_translation(s2.b));
-            let s = &samples[k].sm;
-            [p[0] - s.x, p[1] - s.y, wrap_angle(p[2] - s.theta)]
-        })
+        .map(|(s, u)| residual_of(pred.sensor_from_odometry(&u.scale_translation(s2.b)), &s.sm))
         .collect();
     Ok((
         ClosedForm {
@@ -185,19 +187,27 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     };
     let tw = theta_weights.as_deref();
 
-    let mut active: Vec<usize> = (0..samples.len()).collect();
+    let mut active = Packed::all(samples, options.use_profile);
     let mut samples_per_round = vec![active.len()];
-    let (mut cf, mut residuals) = closed_form(samples, &active, tw, options.use_profile)?;
-    let mut first_round: Option<Vec<usize>> = None;
-    let untrimmed = cf.params;
+    let (mut cf, mut residuals) = closed_form_packed(&active, tw)?;
+    // Scan-matching noise as the original package estimates it: residuals of the
+    // first (untrimmed) closed-form estimate over the samples kept after the first
+    // trimming round (all samples when there is no trimming).
+    let mut noise_residuals: Option<Vec<[f64; 3]>> = None;
     for round in 0..options.trim.rounds() {
         let keep = options.trim.keep(&residuals);
-        active = active
-            .iter()
-            .zip(&keep)
-            .filter(|(_, &k)| k)
-            .map(|(&i, _)| i)
-            .collect();
+        if round == 0 {
+            noise_residuals = Some(
+                residuals
+                    .iter()
+                    .zip(&keep)
+                    .filter(|(_, &k)| k)
+                    .map(|(r, _)| *r)
+                    .collect(),
+            );
+        }
+        let mut kept = keep.iter();
+        active.retain(|_| kept.next().copied().unwrap_or(false));
         samples_per_round.push(active.len());
         if active.len() < MIN_SAMPLES {
             return Err(SolveError::TooFewSamples {
@@ -206,22 +216,9 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
                 stage: format!("after trimming round {}", round + 1),
             });
         }
-        if first_round.is_none() {
-            first_round = Some(active.clone());
-        }
-        (cf, residuals) = closed_form(samples, &active, tw, options.use_profile)?;
+        (cf, residuals) = closed_form_packed(&active, tw)?;
     }
-
-    // Scan-matching noise as the original package estimates it: residuals of the
-    // first (untrimmed) closed-form estimate over the samples kept after the first
-    // trimming round.
-    let noise_set = first_round.as_deref().unwrap_or(&active);
-    let pred = Predictor::new(&untrimmed, options.use_profile);
-    let noise_residuals: Vec<[f64; 3]> = noise_set
-        .iter()
-        .map(|&k| pred.residual(&samples[k]))
-        .collect();
-    let sm_sigma = residual_sigmas(&noise_residuals);
+    let sm_sigma = residual_sigmas(noise_residuals.as_deref().unwrap_or(&residuals));
 
     let (weights, noise_source) = match sample_weights {
         Some(w) => (w, NoiseSource::SampleCovariance),
@@ -231,10 +228,10 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // The last pass of the refinement (or one pass at the closed form) gives the
     // cost and the Fisher information at the estimate.
     let (params, refinement, cost_before, cost_after, information) = if options.refine {
-        let (r, h) = refine(samples, &active, &cf.params, &weights, options.use_profile);
+        let (r, h) = refine(&active, &cf.params, &weights);
         (r.params, Some(r), r.cost_before, r.cost_after, h)
     } else {
-        let ne = accumulate(samples, &active, &cf.params, &weights, options.use_profile);
+        let ne = accumulate(&active, &cf.params, &weights);
         (cf.params, None, ne.cost, ne.cost, ne.h)
     };
     if !params.to_vector().iter().all(|v| v.is_finite()) {
@@ -245,7 +242,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
 
     // Motion classes with the estimated radii; for the "not excited" errors, where
     // the estimate is not trustworthy, with equal radii.
-    let motion_equal_radii = || MotionContent::classify(samples, &active, 1.0, 1.0);
+    let motion_equal_radii = || MotionContent::classify(&active, 1.0, 1.0);
     let covariance = match invert_information(&information) {
         Inversion::Covariance(c) => *c,
         Inversion::Singular(null) => {
@@ -264,7 +261,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     if !not_excited.is_empty() {
         return Err(information_not_excited(not_excited, &motion_equal_radii()));
     }
-    let motion = MotionContent::classify(samples, &active, params.r_l, params.r_r);
+    let motion = MotionContent::classify(&active, params.r_l, params.r_r);
     let observability = Observability {
         step1_condition: cf.step1.condition,
         a_condition: cf.step2.a_condition,
@@ -275,8 +272,8 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         wheel_signs: wheel_signs(&params),
     };
     let mut used = vec![false; samples.len()];
-    for &k in &active {
-        used[k] = true;
+    for p in &active {
+        used[p.index] = true;
     }
     Ok(Calibration {
         j: params.j(),

@@ -259,27 +259,37 @@ impl Predictor {
 
     /// `ŝ_pred` for `sample`, as `[x, y, θ]` (θ wrapped).
     pub fn predict(&self, sample: &Sample) -> [f64; 3] {
-        let p = &self.params;
-        let o = odometry_raw(p.r_l, p.r_r, p.b, pieces(sample, self.use_profile));
-        self.sensor_from_odometry(&o)
+        self.predict_pieces(pieces(sample, self.use_profile))
     }
 
     /// `ŝ_pred − ŝ` for `sample` (angle wrapped).
     pub fn residual(&self, sample: &Sample) -> [f64; 3] {
-        let p = self.predict(sample);
-        [
-            p[0] - sample.sm.x,
-            p[1] - sample.sm.y,
-            wrap_angle(p[2] - sample.sm.theta),
-        ]
+        residual_of(self.predict(sample), &sample.sm.to_array())
     }
 
     /// `ŝ_pred` (θ wrapped) and its Jacobian `G[row][param]` with respect to
     /// `(r_L, r_R, b, ℓx, ℓy, ℓθ)`, rows x, y, θ.
     pub fn predict_with_jacobian(&self, sample: &Sample) -> ([f64; 3], [[f64; 6]; 3]) {
+        self.predict_with_jacobian_pieces(pieces(sample, self.use_profile))
+    }
+
+    /// `ŝ_pred` over the given pieces.
+    #[inline]
+    pub(crate) fn predict_pieces(&self, pieces: Pieces<'_>) -> [f64; 3] {
+        let p = &self.params;
+        let o = odometry_raw(p.r_l, p.r_r, p.b, pieces);
+        self.sensor_from_odometry(&o)
+    }
+
+    /// `ŝ_pred` and its Jacobian over the given pieces.
+    #[inline]
+    pub(crate) fn predict_with_jacobian_pieces(
+        &self,
+        pieces: Pieces<'_>,
+    ) -> ([f64; 3], [[f64; 6]; 3]) {
         let p = &self.params;
         let l = &p.laser;
-        let (o, d) = odometry_with_jacobian(p.r_l, p.r_r, p.b, pieces(sample, self.use_profile));
+        let (o, d) = odometry_with_jacobian(p.r_l, p.r_r, p.b, pieces);
         let s_pred = self.sensor_from_odometry(&o);
         let (sa, ca) = (o.sin, o.cos);
         let (c, s) = (self.cos_l, self.sin_l);
@@ -306,6 +316,16 @@ impl Predictor {
         g[1][5] = -s_pred[0];
         (s_pred, g)
     }
+}
+
+/// `predicted − measured`, angle wrapped.
+#[inline]
+pub(crate) fn residual_of(predicted: [f64; 3], measured: &[f64; 3]) -> [f64; 3] {
+    [
+        predicted[0] - measured[0],
+        predicted[1] - measured[1],
+        wrap_angle(predicted[2] - measured[2]),
+    ]
 }
 
 /// The sensor displacement predicted by the parameters, `ŝ_pred = ⊖ℓ ⊕ o ⊕ ℓ`

@@ -30,6 +30,7 @@ mod linalg;
 mod noise;
 mod normal_equations;
 mod observability;
+mod packed;
 mod params;
 pub mod refine;
 mod sample;

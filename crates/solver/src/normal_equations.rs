@@ -2,11 +2,10 @@
 //! `Σ GᵀWG` (the Fisher information) and the vector `Σ GᵀWe`, with `e = ŝ_pred − ŝ`
 //! and `G = ∂ŝ_pred/∂(r_L, r_R, b, ℓx, ℓy, ℓθ)`.
 
-use crate::kinematics::Predictor;
+use crate::kinematics::{residual_of, Predictor};
 use crate::noise::NoiseWeights;
+use crate::packed::Packed;
 use crate::params::Params;
-use crate::sample::Sample;
-use odocal_geom::wrap_angle;
 
 /// Sums over one pass.
 #[derive(Debug, Clone, Copy)]
@@ -19,22 +18,19 @@ pub(crate) struct NormalEquations {
     pub g: [f64; 6],
 }
 
-/// Accumulates the normal equations over `active` at `params`.
+/// Accumulates the normal equations over `samples` at `params`.
 pub(crate) fn accumulate(
-    samples: &[Sample],
-    active: &[usize],
+    samples: &[Packed],
     params: &Params,
     weights: &NoiseWeights,
-    use_profile: bool,
 ) -> NormalEquations {
-    let pred = Predictor::new(params, use_profile);
+    let pred = Predictor::new(params, true);
     let mut h = [[0.0; 6]; 6];
     let mut g = [0.0; 6];
     let mut cost = 0.0;
-    for &k in active {
-        let s = &samples[k];
-        let (p, jac) = pred.predict_with_jacobian(s);
-        let e = [p[0] - s.sm.x, p[1] - s.sm.y, wrap_angle(p[2] - s.sm.theta)];
+    for s in samples {
+        let (p, jac) = pred.predict_with_jacobian_pieces(s.pieces());
+        let e = residual_of(p, &s.sm);
         match weights {
             NoiseWeights::Shared(w) => {
                 for r in 0..3 {
@@ -50,7 +46,7 @@ pub(crate) fn accumulate(
                 }
             }
             NoiseWeights::PerSample(info) => {
-                let w = &info[k];
+                let w = &info[s.index];
                 // WG (3×6) and We (3).
                 let mut wg = [[0.0; 6]; 3];
                 let mut we = [0.0; 3];

@@ -4,8 +4,8 @@
 //! wheel encoders. Also builds the "not excited" errors for degenerate data.
 
 use crate::error::SolveError;
+use crate::packed::Packed;
 use crate::params::{Params, PARAMETER_NAMES};
-use crate::sample::Sample;
 use crate::step1::Step1;
 use serde::Serialize;
 
@@ -76,13 +76,12 @@ pub struct MotionContent {
 }
 
 impl MotionContent {
-    /// Classifies the samples `active` with radii `r_l`, `r_r` (any consistent
-    /// scale; only their signs and ratio matter).
-    pub fn classify(samples: &[Sample], active: &[usize], r_l: f64, r_r: f64) -> Self {
+    /// Classifies the samples with radii `r_l`, `r_r` (any consistent scale; only
+    /// their signs and ratio matter).
+    pub(crate) fn classify(samples: &[Packed], r_l: f64, r_r: f64) -> Self {
         let mut m = MotionContent::default();
         let scale = 0.5 * (r_l.abs() + r_r.abs());
-        for &k in active {
-            let s = &samples[k];
+        for s in samples {
             let forward = 0.5 * (r_l * s.dphi_l + r_r * s.dphi_r);
             let turning = 0.5 * (r_r * s.dphi_r - r_l * s.dphi_l);
             let (f, t) = (forward.abs(), turning.abs());
@@ -307,8 +306,8 @@ fn names_in(directions: &[Vec<f64>], offset: usize) -> Vec<String> {
 
 /// The error for data whose step-1 normal matrix is singular: the wheel rotations
 /// of all samples lie along one direction.
-pub(crate) fn step1_not_excited(samples: &[Sample], active: &[usize], s1: &Step1) -> SolveError {
-    let motion = MotionContent::classify(samples, active, 1.0, 1.0);
+pub(crate) fn step1_not_excited(samples: &[Packed], s1: &Step1) -> SolveError {
+    let motion = MotionContent::classify(samples, 1.0, 1.0);
     let n = s1.normal;
     let names = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<Vec<_>>();
     if n[0][0] + n[1][1] <= 0.0 {
@@ -359,12 +358,11 @@ pub(crate) fn step1_not_excited(samples: &[Sample], active: &[usize], s1: &Step1
 
 /// The error for data whose step-2 block `A` is singular.
 pub(crate) fn step2_not_excited(
-    samples: &[Sample],
-    active: &[usize],
+    samples: &[Packed],
     s1: &Step1,
     weakest: Option<[f64; 3]>,
 ) -> SolveError {
-    let motion = MotionContent::classify(samples, active, -s1.j21, s1.j22);
+    let motion = MotionContent::classify(samples, -s1.j21, s1.j22);
     let mut parameters = match weakest {
         Some(d) => names_in(&[d.to_vec()], 2),
         None => Vec::new(),

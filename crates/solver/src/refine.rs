@@ -4,8 +4,8 @@
 use crate::linalg::unit_diagonal;
 use crate::noise::NoiseWeights;
 use crate::normal_equations::accumulate;
+use crate::packed::Packed;
 use crate::params::Params;
-use crate::sample::Sample;
 use nalgebra::{SMatrix, SVector};
 use serde::Serialize;
 
@@ -30,17 +30,15 @@ pub struct Refinement {
     pub converged: bool,
 }
 
-/// Refines `start` over the samples `active`; also returns the Gauss–Newton matrix
+/// Refines `start` over `samples`; also returns the Gauss–Newton matrix
 /// (Fisher information) at the refined parameters.
 pub(crate) fn refine(
-    samples: &[Sample],
-    active: &[usize],
+    samples: &[Packed],
     start: &Params,
     weights: &NoiseWeights,
-    use_profile: bool,
 ) -> (Refinement, [[f64; 6]; 6]) {
     let mut params = *start;
-    let mut ne = accumulate(samples, active, &params, weights, use_profile);
+    let mut ne = accumulate(samples, &params, weights);
     let cost_before = ne.cost;
     let mut lambda = 1e-6;
     let mut iterations = 0;
@@ -75,7 +73,7 @@ pub(crate) fn refine(
             v[i] += step_scaled[i] * s[i];
         }
         let trial = Params::from_vector(v);
-        let trial_ne = accumulate(samples, active, &trial, weights, use_profile);
+        let trial_ne = accumulate(samples, &trial, weights);
         if trial_ne.cost.is_finite() && trial_ne.cost <= ne.cost {
             let decrease = ne.cost - trial_ne.cost;
             params = trial;

@@ -2,7 +2,7 @@
 //! `[Δθ_L, Δθ_R]·[J21, J22]ᵀ = ŝθ`.
 
 use crate::linalg::{condition_from_eigenvalues, symmetric_eigen2};
-use crate::sample::Sample;
+use crate::packed::Packed;
 use serde::Serialize;
 
 /// Result of step 1.
@@ -21,21 +21,20 @@ pub struct Step1 {
     pub weakest_direction: [f64; 2],
 }
 
-/// Solves step 1 over the samples `active` (indices into `samples`). With
-/// `theta_weights`, row k is weighted by `theta_weights[k]` (1/σθ²); otherwise all
-/// rows weigh the same. When the normal matrix is singular, `j21`/`j22` are NaN and
-/// `condition` is ∞.
-pub fn step1(samples: &[Sample], active: &[usize], theta_weights: Option<&[f64]>) -> Step1 {
+/// Solves step 1 over `samples`. With `theta_weights`, the row of sample `k` (its
+/// index in the caller's slice) is weighted by `theta_weights[k]` (1/σθ²); otherwise
+/// all rows weigh the same. When the normal matrix is singular, `j21`/`j22` are NaN
+/// and `condition` is ∞.
+pub(crate) fn step1(samples: &[Packed], theta_weights: Option<&[f64]>) -> Step1 {
     let (mut n11, mut n12, mut n22, mut g1, mut g2) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    for &k in active {
-        let s = &samples[k];
-        let w = theta_weights.map_or(1.0, |w| w[k]);
+    for s in samples {
+        let w = theta_weights.map_or(1.0, |w| w[s.index]);
         let (a1, a2) = (s.dphi_l, s.dphi_r);
         n11 += w * a1 * a1;
         n12 += w * a1 * a2;
         n22 += w * a2 * a2;
-        g1 += w * a1 * s.sm.theta;
-        g2 += w * a2 * s.sm.theta;
+        g1 += w * a1 * s.sm[2];
+        g2 += w * a2 * s.sm[2];
     }
     let normal = [[n11, n12], [n12, n22]];
     let (eigs, vecs) = symmetric_eigen2(normal);
@@ -58,6 +57,7 @@ pub fn step1(samples: &[Sample], active: &[usize], theta_weights: Option<&[f64]>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sample::Sample;
     use odocal_geom::Pose2;
 
     #[test]
@@ -69,8 +69,7 @@ mod tests {
                 Sample::from_rotations(1.0, l, r, Pose2::new(0.0, 0.0, j21 * l + j22 * r))
             })
             .collect();
-        let idx: Vec<usize> = (0..samples.len()).collect();
-        let s1 = step1(&samples, &idx, None);
+        let s1 = step1(&Packed::all(&samples, true), None);
         assert!((s1.j21 - j21).abs() < 1e-14 && (s1.j22 - j22).abs() < 1e-14);
         assert!(s1.condition.is_finite());
     }
@@ -81,7 +80,7 @@ mod tests {
             .iter()
             .map(|&a| Sample::from_rotations(1.0, -a, a, Pose2::new(0.0, 0.0, 0.1 * a)))
             .collect();
-        let s1 = step1(&samples, &[0, 1, 2], None);
+        let s1 = step1(&Packed::all(&samples, true), None);
         assert!(s1.condition > 1e12);
         // The unexcited direction is J21 + J22 (a straight-run direction).
         assert!((s1.weakest_direction[0] - s1.weakest_direction[1]).abs() < 1e-9);

@@ -2,11 +2,11 @@
 //! minimising `xᵀMx` over `x = [b, ℓx, ℓy, cos ℓθ, sin ℓθ]` with `x4² + x5² = 1`
 //! through the Schur complement of the 3×3 block `A` of `M`.
 
-use crate::kinematics::{odometry_raw, pieces, RawOdometry};
+use crate::kinematics::{odometry_raw, RawOdometry};
 use crate::linalg::{
     condition_from_eigenvalues, symmetric_eigen2, symmetric_eigen_sorted, unit_diagonal,
 };
-use crate::sample::Sample;
+use crate::packed::Packed;
 use nalgebra::{Matrix2, Matrix3, Matrix3x2, Vector2};
 use odocal_geom::Pose2;
 use serde::Serialize;
@@ -34,37 +34,40 @@ pub struct Step2 {
 /// excited by step 2 (the Schur solution would be numerically meaningless).
 pub const A_SINGULAR_CONDITION: f64 = 1e12;
 
-/// Builds `M` over `active` for the given `J21`, `J22` and returns it with the
-/// per-sample odometry for `b = 1` (`c_x`, `c_y`, `oθ`; same order as `active`), so
-/// that the robot displacement is `(b·c_x, b·c_y, oθ)`.
-pub(crate) fn build_m(
-    samples: &[Sample],
-    active: &[usize],
-    j21: f64,
-    j22: f64,
-    use_profile: bool,
-) -> ([[f64; 5]; 5], Vec<RawOdometry>) {
-    let mut m = [[0.0; 5]; 5];
-    let mut unit = Vec::with_capacity(active.len());
-    for &k in active {
-        let s = &samples[k];
-        let o = odometry_raw(-j21, j22, 1.0, pieces(s, use_profile));
+/// Builds `M` over `samples` for the given `J21`, `J22` and returns it with the
+/// per-sample odometry for `b = 1` (`c_x`, `c_y`, `oθ`; same order as `samples`),
+/// so that the robot displacement is `(b·c_x, b·c_y, oθ)`.
+pub(crate) fn build_m(samples: &[Packed], j21: f64, j22: f64) -> ([[f64; 5]; 5], Vec<RawOdometry>) {
+    // With r1 = [−c_x, 1−cos, sin, ŝx, −ŝy] and r2 = [−c_y, −sin, 1−cos, ŝy, ŝx],
+    // r1ᵀr1 + r2ᵀr2 has M11 = M22 = 2(1 − cos), M12 = M34 = 0, M33 = M44; the other
+    // entries are the eleven sums below.
+    let mut sum = [0.0; 11];
+    let mut unit = Vec::with_capacity(samples.len());
+    for s in samples {
+        let o = odometry_raw(-j21, j22, 1.0, s.pieces());
         unit.push(o);
         let (sn, omc) = (o.sin, o.one_minus_cos());
-        let (sx, sy) = (s.sm.x, s.sm.y);
-        let r1 = [-o.x, omc, sn, sx, -sy];
-        let r2 = [-o.y, -sn, omc, sy, sx];
-        for i in 0..5 {
-            for j in i..5 {
-                m[i][j] += r1[i] * r1[j] + r2[i] * r2[j];
-            }
-        }
+        let (cx, cy) = (o.x, o.y);
+        let (sx, sy) = (s.sm[0], s.sm[1]);
+        sum[0] += cx * cx + cy * cy;
+        sum[1] += cy * sn - cx * omc;
+        sum[2] += -cx * sn - cy * omc;
+        sum[3] += -cx * sx - cy * sy;
+        sum[4] += cx * sy - cy * sx;
+        sum[5] += 2.0 * omc;
+        sum[6] += omc * sx - sn * sy;
+        sum[7] += -omc * sy - sn * sx;
+        sum[8] += sn * sx + omc * sy;
+        sum[9] += omc * sx - sn * sy;
+        sum[10] += sx * sx + sy * sy;
     }
-    for i in 0..5 {
-        for j in 0..i {
-            m[i][j] = m[j][i];
-        }
-    }
+    let m = [
+        [sum[0], sum[1], sum[2], sum[3], sum[4]],
+        [sum[1], sum[5], 0.0, sum[6], sum[7]],
+        [sum[2], 0.0, sum[5], sum[8], sum[9]],
+        [sum[3], sum[6], sum[8], sum[10], 0.0],
+        [sum[4], sum[7], sum[9], 0.0, sum[10]],
+    ];
     (m, unit)
 }
 
@@ -116,6 +119,39 @@ mod tests {
     use super::*;
     use crate::kinematics::Predictor;
     use crate::params::Params;
+    use crate::sample::Sample;
+
+    #[test]
+    fn m_equals_sum_of_row_outer_products() {
+        let samples: Vec<Sample> = [
+            (1.0, 2.0, 0.1, -0.02, 0.3),
+            (-1.0, 1.0, 0.0, 0.05, -1.0),
+            (3.0, 3.1, 0.3, 0.01, 0.02),
+        ]
+        .iter()
+        .map(|&(l, r, x, y, t)| Sample::from_rotations(1.0, l, r, Pose2::new(x, y, t)))
+        .collect();
+        let packed = Packed::all(&samples, true);
+        let (j21, j22) = (-0.2, 0.19);
+        let (m, _) = build_m(&packed, j21, j22);
+        let mut want = [[0.0; 5]; 5];
+        for s in &packed {
+            let o = odometry_raw(-j21, j22, 1.0, s.pieces());
+            let (sn, omc) = (o.theta.sin(), 1.0 - o.theta.cos());
+            let r1 = [-o.x, omc, sn, s.sm[0], -s.sm[1]];
+            let r2 = [-o.y, -sn, omc, s.sm[1], s.sm[0]];
+            for i in 0..5 {
+                for j in 0..5 {
+                    want[i][j] += r1[i] * r1[j] + r2[i] * r2[j];
+                }
+            }
+        }
+        for i in 0..5 {
+            for j in 0..5 {
+                assert!((m[i][j] - want[i][j]).abs() < 1e-12, "M[{i}][{j}]");
+            }
+        }
+    }
 
     #[test]
     fn recovers_b_and_laser_on_exact_data() {
@@ -136,9 +172,8 @@ mod tests {
                 }
             })
             .collect();
-        let idx: Vec<usize> = (0..samples.len()).collect();
         let j = truth.j();
-        let (m, _) = build_m(&samples, &idx, j[1][0], j[1][1], true);
+        let (m, _) = build_m(&Packed::all(&samples, true), j[1][0], j[1][1]);
         let s2 = solve_m(&m).unwrap();
         assert!((s2.b - truth.b).abs() < 1e-12);
         assert!((s2.laser.x - truth.laser.x).abs() < 1e-12);
