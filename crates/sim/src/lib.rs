@@ -14,7 +14,8 @@
 //!
 //! And the whole: [`SimConfig`] (or [`SimConfig::preset`]) → [`simulate`] →
 //! [`SimRun`] (every record with its truth, in memory) → [`SimRun::write_log`] and
-//! [`SimRun::write_truth`]. Everything is deterministic from [`SimConfig::seed`]
+//! [`SimRun::write_truth`] (or [`SimRun::to_log`] for the reader's data model without
+//! text). Everything is deterministic from [`SimConfig::seed`]
 //! (ChaCha8 streams, one per purpose).
 //!
 //! ```
@@ -35,6 +36,7 @@ mod drive;
 mod encoder;
 mod error;
 mod faults;
+mod in_memory;
 mod kinematics;
 mod laser;
 mod output;

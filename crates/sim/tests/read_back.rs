@@ -74,3 +74,30 @@ fn garbage_is_skipped_in_lenient_mode_and_stops_strict_mode() {
         Ok(_) => panic!("strict mode accepted a malformed line"),
     }
 }
+
+#[test]
+fn in_memory_log_matches_the_written_one() {
+    let mut c = SimConfig::preset("khepera-displaced").unwrap();
+    c.seed = 33;
+    c.duration = 8.0;
+    c.faults.drop_fraction = 0.05;
+    c.faults.clock_offset = 0.3; // reorders scans relative to encoder records
+    let (run, log, _) = written(&c);
+    let read = read_carmen_from(&log[..], "sim.log", &ReadOptions::default()).unwrap();
+    let mem = run.to_log();
+    assert_eq!(mem.params.ticks_per_revolution.as_ref().unwrap().0, 2764.8);
+    assert_eq!(mem.encoders.len(), read.encoders.len());
+    for (a, b) in mem.encoders.iter().zip(&read.encoders) {
+        assert_eq!((a.t, a.left, a.right), (b.t, b.left, b.right));
+    }
+    assert_eq!(mem.scans.len(), read.scans.len());
+    for (a, b) in mem.scans.iter().zip(read.scans.iter()) {
+        assert_eq!(a.t, b.t);
+        assert_eq!(a.ranges, b.ranges);
+        assert!(a.geometry.same_rays(b.geometry));
+    }
+    assert_eq!(mem.odom.len(), read.odom.len());
+    for (a, b) in mem.odom.iter().zip(&read.odom) {
+        assert_eq!((a.t, a.pose, a.tv, a.rv), (b.t, b.pose, b.tv, b.rv));
+    }
+}
