@@ -284,7 +284,8 @@ fn connections(
             .discontinuity_min_gap
             .max(params.discontinuity_gap_factor * r * (angles[i + 1] - angles[i]).abs());
         let (p, q) = (points[i], points[i + 1]);
-        connected[i] = (q[0] - p[0]).hypot(q[1] - p[1]) <= gap_allowed;
+        let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
+        connected[i] = dx * dx + dy * dy <= gap_allowed * gap_allowed;
     }
     connected
 }
@@ -313,8 +314,21 @@ fn local_lines(
         let run_len = end - start + 1;
         let w = params.line_fit_window.min(run_len);
         fits.clear();
+        // Sliding moments about the run's first point, recomputed from scratch every
+        // 32 windows to bound the rounding drift of the additions and subtractions.
+        let origin = points[start];
+        let mut moments = Moments::default();
         for s in start..=end + 1 - w {
-            fits.push(fit_window(&points[s..s + w]));
+            if (s - start) % 32 == 0 {
+                moments = Moments::default();
+                for p in &points[s..s + w] {
+                    moments.add(*p, origin, 1.0);
+                }
+            } else {
+                moments.add(points[s - 1], origin, -1.0);
+                moments.add(points[s + w - 1], origin, 1.0);
+            }
+            fits.push(moments.fit(origin, w));
         }
         for (i, segment) in segments.iter_mut().enumerate().take(end).skip(start) {
             // Windows s..s+w containing i and i+1: s in [i + 2 - w, i] within the run.
@@ -338,29 +352,65 @@ fn local_lines(
     segments
 }
 
+/// Sums of a window's coordinates about an origin, and their products.
+#[derive(Debug, Clone, Copy, Default)]
+struct Moments {
+    x: f64,
+    y: f64,
+    xx: f64,
+    xy: f64,
+    yy: f64,
+}
+
+impl Moments {
+    /// Adds (`sign` = 1) or removes (`sign` = −1) point `p`.
+    #[inline]
+    fn add(&mut self, p: [f64; 2], origin: [f64; 2], sign: f64) {
+        let (dx, dy) = (p[0] - origin[0], p[1] - origin[1]);
+        self.x += sign * dx;
+        self.y += sign * dy;
+        self.xx += sign * dx * dx;
+        self.xy += sign * dx * dy;
+        self.yy += sign * dy * dy;
+    }
+
+    /// The total-least-squares line of the `count` points summed.
+    fn fit(&self, origin: [f64; 2], count: usize) -> WindowFit {
+        let k = count as f64;
+        let (mx, my) = (self.x / k, self.y / k);
+        let sxx = (self.xx - mx * self.x).max(0.0);
+        let syy = (self.yy - my * self.y).max(0.0);
+        let sxy = self.xy - mx * self.y;
+        line_from_scatter(origin, mx, my, sxx, sxy, syy, k)
+    }
+}
+
 /// Total-least-squares line through `pts` (at least 2 points) and its RMS residual.
+#[cfg(test)]
 fn fit_window(pts: &[[f64; 2]]) -> WindowFit {
-    // Moments about the first point, to avoid cancellation.
-    let o = pts[0];
-    let k = pts.len() as f64;
-    let (mut sx, mut sy) = (0.0, 0.0);
+    let mut m = Moments::default();
     for p in pts {
-        sx += p[0] - o[0];
-        sy += p[1] - o[1];
+        m.add(*p, pts[0], 1.0);
     }
-    let (mx, my) = (sx / k, sy / k);
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for p in pts {
-        let dx = p[0] - o[0] - mx;
-        let dy = p[1] - o[1] - my;
-        sxx += dx * dx;
-        sxy += dx * dy;
-        syy += dy * dy;
-    }
+    m.fit(pts[0], pts.len())
+}
+
+/// The line through the centroid `origin + (mx, my)` along the major axis of the
+/// centred scatter `[[sxx, sxy], [sxy, syy]]` of `k` points.
+fn line_from_scatter(
+    o: [f64; 2],
+    mx: f64,
+    my: f64,
+    sxx: f64,
+    sxy: f64,
+    syy: f64,
+    k: f64,
+) -> WindowFit {
     // Smallest eigenvalue of the scatter [[sxx, sxy], [sxy, syy]] and its eigenvector
     // (the normal), from whichever of the two equivalent forms is better conditioned.
     let half_trace = 0.5 * (sxx + syy);
-    let half_diff = (0.5 * (sxx - syy)).hypot(sxy);
+    let half_gap = 0.5 * (sxx - syy);
+    let half_diff = (half_gap * half_gap + sxy * sxy).sqrt();
     let smallest = (half_trace - half_diff).max(0.0);
     let u = [sxy, smallest - sxx];
     let v = [smallest - syy, sxy];

@@ -32,8 +32,21 @@ pub(crate) fn threshold(
     if m == 0 {
         return (0.0, false);
     }
-    let mid = m / 2;
-    let (_, median_sq, upper) = squared_residuals.select_nth_unstable_by(mid, f64::total_cmp);
+    // Median of the squared residuals; above 256 matches (and when no fractional
+    // trimming needs the whole slice afterwards), of every k-th one only, gathered at
+    // the front of the scratch slice: the spread needs no more precision.
+    let stride = if params.trim_fraction < 1.0 {
+        1
+    } else {
+        (m / 128).max(1)
+    };
+    let sampled = m / stride;
+    for i in 1..sampled {
+        squared_residuals[i] = squared_residuals[i * stride];
+    }
+    let (_, median_sq, _) =
+        squared_residuals[..sampled].select_nth_unstable_by(sampled / 2, f64::total_cmp);
+    let median_sq = *median_sq;
     let median = median_sq.sqrt();
     let sigma = MAD_TO_SIGMA * median;
     let step_term = match previous_motion {
@@ -46,14 +59,8 @@ pub(crate) fn threshold(
     if params.trim_fraction < 1.0 {
         // Keep the ⌈q·m⌉ smallest residuals at most.
         let keep = ((params.trim_fraction * m as f64).ceil() as usize).clamp(1, m);
-        let q_index = keep - 1;
-        let quantile = if q_index <= mid {
-            median
-        } else {
-            let (_, q, _) = upper.select_nth_unstable_by(q_index - mid - 1, f64::total_cmp);
-            q.sqrt()
-        };
-        tau = tau.min(quantile);
+        let (_, q, _) = squared_residuals.select_nth_unstable_by(keep - 1, f64::total_cmp);
+        tau = tau.min(q.sqrt());
     }
     (tau, motion_limited)
 }
