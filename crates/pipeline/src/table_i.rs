@@ -284,7 +284,12 @@ pub fn parse_table(text: &str, path: &Path) -> Result<Vec<PublishedRow>, TableEr
             }
         };
         let row = PublishedRow {
-            source: format!("table file {}", path.display()),
+            source: format!(
+                "table file `{}`",
+                path.file_name()
+                    .unwrap_or(path.as_os_str())
+                    .to_string_lossy()
+            ),
             samples: r.samples,
             printed: r.si,
             j,
@@ -342,7 +347,7 @@ pub fn read_tro_reference(dir: &Path) -> Result<Vec<PublishedRow>, TableError> {
         let sigma = std::array::from_fn(|i| r.covariance[i][i].max(0.0).sqrt());
         let row = PublishedRow {
             name: name.to_string(),
-            source: format!("{description} (published results, {})", path.display()),
+            source: format!("{description}; the package's published `{name}_results.json`"),
             samples,
             printed: PrintedParams {
                 r_l: r.l_diam / 2.0,
@@ -716,7 +721,7 @@ pub fn format_reproduction(rep: &Reproduction, tol: &Tolerances) -> String {
         let (k, _, d) = display_unit(c.name);
         let relative = match c.name {
             "l_x" | "l_y" | "l_theta" => String::new(),
-            _ => format!(" ({:+.3} %)", 100.0 * c.error / c.published),
+            _ => format!(" ({:+.3} %)", 100.0 * c.error / c.published.abs()),
         };
         let _ = writeln!(
             s,
@@ -816,7 +821,7 @@ mod tests {
     const TABLE: &str = r#"{"citation": "made up", "rows": [
         {"name": "swapped", "samples": 1200,
          "si": {"r_l": 0.0212, "r_r": 0.0208, "b": 0.09, "l_x": 0.01, "l_y": -0.02, "l_theta": 0.3},
-         "J11": 0.0106, "J12": 0.0104, "J21": -0.2311111, "J22": 0.2355556,
+         "J11": 0.0104, "J12": 0.0106, "J21": -0.2311111, "J22": 0.2355556,
          "sigma": {"r_l": 4e-5, "r_r": 4e-5, "b": 2e-4, "l_x": 8e-5, "l_y": 1e-4, "l_theta": 1.5e-3}},
         {"name": "plain", "samples": 900,
          "si": {"r_l": 0.0208, "r_r": 0.0212, "b": 0.09, "l_x": 0.0, "l_y": 0.0, "l_theta": 0.0},
@@ -918,7 +923,8 @@ mod tests {
         assert_eq!(rows[2].samples, 4345);
         let t = a.truth();
         assert_eq!(t.b, 0.0890519);
-        assert!((t.r_l - 0.0208855).abs() < 1e-10 && (t.r_r - 0.02094785).abs() < 1e-10);
+        // `l_diam`, `r_diam` are diameters: 0.0417709 / 2, 0.0418957 / 2.
+        assert!((t.r_l - 0.02088545).abs() < 1e-12 && (t.r_r - 0.02094785).abs() < 1e-12);
         assert_eq!(t.laser, Pose2::new(-0.00581279, 0.000185606, 0.00949588));
         assert!((a.sigma.unwrap()[2] - 4.38323e-08f64.sqrt()).abs() < 1e-12);
     }

@@ -6,7 +6,8 @@
 //! (with the configured trimming) is solved, and the cost is the mean truncated
 //! squared residual of *all* samples, normalized by the residual scale found at the
 //! starting offset — the truncation keeps outliers (slip, bad matches) from steering
-//! the search. A grid (10 ms steps) finds the basin, golden-section search refines it.
+//! the search. A grid (10 ms steps, on at most [`GRID_SAMPLES`] evenly spread samples) finds
+//! the basin; golden-section search on all samples refines it.
 
 use crate::error::PipelineError;
 use crate::run::{Options, Synchronized};
@@ -18,6 +19,8 @@ use serde::Serialize;
 
 /// Grid spacing of the coarse search (s).
 pub const GRID_STEP_S: f64 = 0.01;
+/// At most about this many samples enter each cost of the coarse grid.
+pub const GRID_SAMPLES: usize = 1500;
 /// Tolerance of the golden-section refinement (s).
 pub const TOLERANCE_S: f64 = 1e-4;
 /// Squared normalized residuals are capped at this value.
@@ -30,9 +33,9 @@ pub struct OffsetEstimate {
     pub offset: f64,
     /// Cost at the estimate.
     pub cost: f64,
-    /// Cost at the starting offset.
+    /// Cost at the starting offset (on the coarse grid's samples).
     pub cost_at_start: f64,
-    /// The coarse grid: (offset s, cost).
+    /// The coarse grid: (offset s, cost on its subsample of the samples).
     pub grid: Vec<(f64, f64)>,
 }
 
@@ -59,11 +62,13 @@ struct Problem<'a> {
 }
 
 impl Problem<'_> {
-    fn samples_at(&self, offset: f64) -> Vec<Sample> {
+    /// The samples rebuilt at `offset`; `every` > 1 keeps one sample in `every`.
+    fn samples_at(&self, offset: f64, every: usize) -> Vec<Sample> {
         let track = EncoderTrack::new(&self.log.encoders, self.synced.ticks_per_revolution);
         self.synced
             .samples
             .iter()
+            .step_by(every.max(1))
             .filter_map(|s| {
                 let wheel = track
                     .motion(s.pair.t0 - offset, s.pair.t1 - offset, &self.synced.limits)
@@ -87,8 +92,8 @@ impl Problem<'_> {
         total / samples.len().max(1) as f64
     }
 
-    fn cost(&self, offset: f64) -> f64 {
-        let samples = self.samples_at(offset);
+    fn cost(&self, offset: f64, every: usize) -> f64 {
+        let samples = self.samples_at(offset, every);
         let mut solve = self.opts.solve;
         solve.refine = false;
         match odocal_solver::calibrate(&samples, &solve) {
@@ -113,18 +118,21 @@ pub fn estimate_time_offset(
         opts,
         scale: [1.0; 3],
     };
-    let samples = problem.samples_at(start);
+    let samples = problem.samples_at(start, 1);
     let predictor = Predictor::new(&base.params, opts.use_profile);
     let residuals: Vec<[f64; 3]> = samples.iter().map(|s| predictor.residual(s)).collect();
     problem.scale = residual_scale(&residuals);
 
+    // The coarse grid only has to find the basin: a subsample keeps it fast on long
+    // logs; the refinement uses every sample.
+    let coarse_every = synced.samples.len().div_ceil(GRID_SAMPLES).max(1);
     let n = ((range / GRID_STEP_S).round() as i64).max(5);
     let step = range / n as f64;
     let grid: Vec<(f64, f64)> = (-n..=n)
         .into_par_iter()
         .map(|i| {
             let d = start + i as f64 * step;
-            (d, problem.cost(d))
+            (d, problem.cost(d, coarse_every))
         })
         .collect();
     let (best, best_cost) = grid
@@ -143,25 +151,30 @@ pub fn estimate_time_offset(
     let (mut a, mut b) = (best - step, best + step);
     let mut c = b - g * (b - a);
     let mut d = a + g * (b - a);
-    let (mut fc, mut fd) = (problem.cost(c), problem.cost(d));
+    let (mut fc, mut fd) = (problem.cost(c, 1), problem.cost(d, 1));
     while b - a > TOLERANCE_S {
         if fc <= fd {
             b = d;
             d = c;
             fd = fc;
             c = b - g * (b - a);
-            fc = problem.cost(c);
+            fc = problem.cost(c, 1);
         } else {
             a = c;
             c = d;
             fc = fd;
             d = a + g * (b - a);
-            fd = problem.cost(d);
+            fd = problem.cost(d, 1);
         }
     }
     let (mut offset, mut cost) = if fc <= fd { (c, fc) } else { (d, fd) };
-    if best_cost < cost {
-        (offset, cost) = (best, best_cost);
+    let best_full = if coarse_every == 1 {
+        best_cost
+    } else {
+        problem.cost(best, 1)
+    };
+    if best_full < cost {
+        (offset, cost) = (best, best_full);
     }
     let cost_at_start = grid
         .iter()
