@@ -7,7 +7,8 @@ use anyhow::Context;
 use odocal_geom::Pose2;
 use odocal_log::{read_tuples, TupleRecord};
 use odocal_solver::{
-    calibrate, Calibration, ProfileSegment, Sample, SolveOptions, Trim, Verdict, PARAMETER_NAMES,
+    calibrate, Calibration, ProfileSegment, Sample, SigmaEstimate, SolveOptions, Trim, Verdict,
+    PARAMETER_NAMES,
 };
 use serde::Serialize;
 use std::path::PathBuf;
@@ -41,6 +42,15 @@ impl TrimRule {
     }
 }
 
+/// Where the scan-matching σ's are estimated (command line).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SigmaFrom {
+    /// As the original package.
+    FirstRound,
+    /// From the final samples.
+    Final,
+}
+
 /// Arguments of `odocal solve`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -55,6 +65,11 @@ pub struct Args {
     /// Ignore wheel-speed profiles (use the constant-speed formulas).
     #[arg(long)]
     pub no_profile: bool,
+    /// Residuals the scan-matching σ's come from: `first-round` (the original
+    /// package: untrimmed estimate, samples kept after the first trimming round) or
+    /// `final` (final estimate and samples; tighter when outliers survive round 1).
+    #[arg(long, value_enum, default_value = "first-round")]
+    pub sigma: SigmaFrom,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -98,6 +113,7 @@ struct JsonOutput<'a> {
     noise_source: odocal_solver::NoiseSource,
     cost_before: f64,
     cost_after: f64,
+    reduced_chi2: f64,
     observability: &'a odocal_solver::Observability,
 }
 
@@ -109,6 +125,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         trim: args.trim.to_trim(),
         refine: !args.no_refine,
         use_profile: !args.no_profile,
+        sigma_from: match args.sigma {
+            SigmaFrom::FirstRound => SigmaEstimate::FirstRound,
+            SigmaFrom::Final => SigmaEstimate::FinalSet,
+        },
         ..SolveOptions::default()
     };
     let cal = calibrate(&samples, &options)
@@ -134,6 +154,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             noise_source: cal.noise_source,
             cost_before: cal.cost_before,
             cost_after: cal.cost_after,
+            reduced_chi2: cal.reduced_chi2,
             observability: &cal.observability,
         };
         let mut text = serde_json::to_string_pretty(&out).context("serializing the result")?;
@@ -229,6 +250,18 @@ fn summary(args: &Args, cal: &Calibration, total: usize) -> String {
             let _ = writeln!(s, "  closed form only: cost {:.6e}", cal.cost_before);
         }
     }
+    let _ = writeln!(
+        s,
+        "  reduced χ² {:.3}{}",
+        cal.reduced_chi2,
+        if cal.reduced_chi2 < 0.5 {
+            " (< 1: the σ's, hence the covariance, are conservative; try --sigma final)"
+        } else if cal.reduced_chi2 > 2.0 {
+            " (> 1: the noise model underestimates the residuals; the covariance is optimistic)"
+        } else {
+            ""
+        }
+    );
     let o = &cal.observability;
     let _ = writeln!(
         s,

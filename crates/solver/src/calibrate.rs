@@ -39,6 +39,23 @@ pub struct SolveOptions {
     pub use_profile: bool,
     /// Weight step 1 by 1/σθ² when every sample has a covariance (default true).
     pub weighted_step1: bool,
+    /// Which residuals the scan-matching σ's come from (default: as the original
+    /// package, [`SigmaEstimate::FirstRound`]).
+    pub sigma_from: SigmaEstimate,
+}
+
+/// Which residuals `ŝ_pred − ŝ` the scan-matching standard deviations are estimated
+/// from (they weight the refinement and scale the covariance, unless every sample
+/// carries its own `sm_cov`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SigmaEstimate {
+    /// As the original package: residuals of the first (untrimmed) closed-form
+    /// estimate over the samples kept after the first trimming round. Conservative
+    /// when outliers survive the first round.
+    FirstRound,
+    /// Residuals of the final closed-form estimate over the final samples.
+    FinalSet,
 }
 
 impl Default for SolveOptions {
@@ -48,6 +65,7 @@ impl Default for SolveOptions {
             refine: true,
             use_profile: true,
             weighted_step1: true,
+            sigma_from: SigmaEstimate::FirstRound,
         }
     }
 }
@@ -84,9 +102,8 @@ pub struct Calibration {
     pub j: [[f64; 2]; 2],
     /// Covariance of (r_L, r_R, b, ℓx, ℓy, ℓθ) at the estimate.
     pub covariance: [[f64; 6]; 6],
-    /// Standard deviations (x, y, θ) of `ŝ_pred − ŝ` at the first (untrimmed)
-    /// closed-form estimate over the samples kept after the first trimming round
-    /// (m, m, rad), as the original package estimates the scan-matching noise.
+    /// Standard deviations (x, y, θ) of `ŝ_pred − ŝ` (m, m, rad), from the residuals
+    /// chosen by [`SolveOptions::sigma_from`].
     pub sm_sigma: [f64; 3],
     /// Source of the residual weights used by the refinement and the covariance.
     pub noise_source: NoiseSource,
@@ -100,6 +117,10 @@ pub struct Calibration {
     pub cost_before: f64,
     /// The same cost at the returned estimate.
     pub cost_after: f64,
+    /// `cost_after / (3·samples_used − 6)`: about 1 when the noise model fits the
+    /// samples used; well below 1 means the covariance is conservative (σ's inflated
+    /// by outliers that only later rounds removed), well above 1 that it is optimistic.
+    pub reduced_chi2: f64,
     /// Details of the refinement, when it ran.
     pub refinement: Option<Refinement>,
     /// Observability report.
@@ -218,7 +239,12 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         }
         (cf, residuals) = closed_form_packed(&active, tw)?;
     }
-    let sm_sigma = residual_sigmas(noise_residuals.as_deref().unwrap_or(&residuals));
+    let sm_sigma = match options.sigma_from {
+        SigmaEstimate::FirstRound => {
+            residual_sigmas(noise_residuals.as_deref().unwrap_or(&residuals))
+        }
+        SigmaEstimate::FinalSet => residual_sigmas(&residuals),
+    };
 
     let (weights, noise_source) = match sample_weights {
         Some(w) => (w, NoiseSource::SampleCovariance),
@@ -287,6 +313,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         samples_per_round,
         cost_before,
         cost_after,
+        reduced_chi2: cost_after / (3 * active.len()).saturating_sub(6).max(1) as f64,
         refinement,
         observability,
     })

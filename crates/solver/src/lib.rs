@@ -39,8 +39,8 @@ pub mod step2;
 pub mod trimming;
 
 pub use calibrate::{
-    calibrate, closed_form, Calibration, ClosedForm, NoiseSource, SolveOptions, MIN_SAMPLES,
-    STEP1_SINGULAR_CONDITION,
+    calibrate, closed_form, Calibration, ClosedForm, NoiseSource, SigmaEstimate, SolveOptions,
+    MIN_SAMPLES, STEP1_SINGULAR_CONDITION,
 };
 pub use covariance::INFORMATION_SINGULAR_RATIO;
 pub use error::SolveError;

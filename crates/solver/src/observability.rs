@@ -409,3 +409,75 @@ pub(crate) fn null_direction_names(null: &[[f64; 6]]) -> Vec<String> {
     let dirs: Vec<Vec<f64>> = null.iter().map(|d| d.to_vec()).collect();
     names_in(&dirs, 0)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use odocal_geom::Pose2;
+
+    fn params(r_l: f64, r_r: f64) -> Params {
+        Params {
+            r_l,
+            r_r,
+            b: 0.3,
+            laser: Pose2::new(0.1, 0.0, 0.0),
+        }
+    }
+
+    #[test]
+    fn verdicts_follow_the_thresholds() {
+        let p = params(0.03, 0.03);
+        let mut cov = [[0.0; 6]; 6];
+        // r_L: 1 % (well), r_R: 10 % (weak), b: 50 % (not excited),
+        // ℓx: 1 cm of a 30 cm base (well), ℓy: 3 cm (weak), ℓθ: 1 rad (not excited).
+        let sigmas = [0.0003, 0.003, 0.15, 0.01, 0.03, 1.0];
+        for i in 0..6 {
+            cov[i][i] = sigmas[i] * sigmas[i];
+        }
+        let v: Vec<Verdict> = parameter_reports(&p, &cov)
+            .iter()
+            .map(|r| r.verdict)
+            .collect();
+        use Verdict::*;
+        assert_eq!(
+            v,
+            vec![
+                WellDetermined,
+                Weak,
+                NotExcited,
+                WellDetermined,
+                Weak,
+                NotExcited
+            ]
+        );
+    }
+
+    #[test]
+    fn wheel_sign_notes() {
+        assert!(wheel_signs(&params(0.03, 0.03)).is_none());
+        assert!(wheel_signs(&params(-0.03, 0.03))
+            .unwrap()
+            .contains("left encoder"));
+        assert!(wheel_signs(&params(0.03, -0.03))
+            .unwrap()
+            .contains("right encoder"));
+        assert!(wheel_signs(&params(-0.03, -0.03))
+            .unwrap()
+            .contains("swapped"));
+    }
+
+    #[test]
+    fn advice_names_the_missing_motion() {
+        let motion = MotionContent {
+            spins: 0,
+            straight: 50,
+            turning_while_translating: 0,
+            still: 0,
+        };
+        let text = advice(&["l_x", "l_y"], &motion);
+        assert!(
+            text.contains("no spins in place") && text.contains("turns"),
+            "{text}"
+        );
+    }
+}

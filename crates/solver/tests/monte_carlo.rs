@@ -59,6 +59,7 @@ fn shared_noise_unbiased_consistent_and_refinement_helps() {
     let sigma = [0.002, 0.002, 0.004];
     let mut r = rng(10);
     let (mut closed, mut refined, mut nees_sum) = (Vec::new(), Vec::new(), 0.0);
+    let mut chi2_sum = 0.0;
     for _ in 0..runs {
         let mut samples = exact_samples(&mut r, &truth, 300, 1);
         add_noise(&mut r, &mut samples, sigma);
@@ -71,7 +72,18 @@ fn shared_noise_unbiased_consistent_and_refinement_helps() {
         closed.push(cal.closed_form.difference(&truth));
         refined.push(cal.params.difference(&truth));
         nees_sum += nees(&cal, &truth);
+        chi2_sum += cal.reduced_chi2;
+        for c in 0..3 {
+            assert!(
+                (cal.sm_sigma[c] / sigma[c] - 1.0).abs() < 0.15,
+                "σ estimate {:?}",
+                cal.sm_sigma
+            );
+        }
     }
+    let mean_chi2 = chi2_sum / runs as f64;
+    println!("mean reduced χ² {mean_chi2:.4}");
+    assert!((mean_chi2 - 1.0).abs() < 0.02);
     let c = stats(&closed);
     let f = stats(&refined);
     let mean_nees = nees_sum / runs as f64;

@@ -5,7 +5,7 @@
 
 mod common;
 
-use odocal_solver::{calibrate, SolveOptions, Trim};
+use odocal_solver::{calibrate, SigmaEstimate, SolveOptions, Trim};
 
 #[test]
 fn reproduces_published_results() {
@@ -58,5 +58,47 @@ fn reproduces_published_results() {
             worst_cov < 0.05,
             "{name}: covariance diagonal differs by {worst_cov:.3}"
         );
+
+        // The maximum-likelihood refinement lowers the cost and moves each parameter
+        // by well under one standard deviation of the closed form.
+        let refined = calibrate(
+            &samples,
+            &SolveOptions {
+                trim: Trim::TRO,
+                ..SolveOptions::default()
+            },
+        )
+        .expect("refined calibration succeeds");
+        assert!(refined.cost_after <= refined.cost_before);
+        let d = refined.params.difference(&cal.params);
+        let moves: Vec<f64> = (0..6)
+            .map(|i| d[i].abs() / cal.covariance[i][i].sqrt())
+            .collect();
+        println!(
+            "{name}: refinement cost {:.6e} → {:.6e}, moves in σ {moves:.3?}",
+            refined.cost_before, refined.cost_after
+        );
+        assert!(
+            moves.iter().all(|&m| m < 0.5),
+            "{name}: refinement moved too far"
+        );
+
+        // With σ's from the final samples, the noise model fits them (reduced χ² ≈ 1);
+        // the original's first-round σ's are larger (conservative covariance).
+        let final_set = calibrate(
+            &samples,
+            &SolveOptions {
+                trim: Trim::TRO,
+                sigma_from: SigmaEstimate::FinalSet,
+                ..SolveOptions::default()
+            },
+        )
+        .expect("calibration with final-set σ");
+        println!(
+            "{name}: reduced χ² {:.3} (first-round σ {:?}) vs {:.3} (final-set σ {:?})",
+            refined.reduced_chi2, refined.sm_sigma, final_set.reduced_chi2, final_set.sm_sigma
+        );
+        assert!((final_set.reduced_chi2 - 1.0).abs() < 0.05);
+        assert!(refined.reduced_chi2 <= final_set.reduced_chi2);
     }
 }
