@@ -53,7 +53,13 @@ fn bench(c: &mut Criterion) {
             c.bench_function(&format!("icp_pair/prepare/{world}/{search:?}"), |b| {
                 b.iter(|| {
                     k = (k + 1) % run.scans.len();
-                    black_box(PreparedScan::new(&run.scans[k].ranges, &angles, 0.02, 4.0, &params))
+                    black_box(PreparedScan::new(
+                        &run.scans[k].ranges,
+                        &angles,
+                        0.02,
+                        4.0,
+                        &params,
+                    ))
                 })
             });
         }

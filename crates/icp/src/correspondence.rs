@@ -89,7 +89,11 @@ pub(crate) fn nearest_by_angle(
 }
 
 /// Closest valid reference point to `p` within `sqrt(max_dist2)`, by the k-d tree.
-pub(crate) fn nearest_by_tree(reference: &PreparedScan, p: [f64; 2], max_dist2: f64) -> Option<usize> {
+pub(crate) fn nearest_by_tree(
+    reference: &PreparedScan,
+    p: [f64; 2],
+    max_dist2: f64,
+) -> Option<usize> {
     let tree = reference.tree.as_ref()?;
     let found = tree.nearest_one::<SquaredEuclidean>(&p);
     (found.distance < max_dist2).then(|| reference.valid_indices[found.item as usize] as usize)

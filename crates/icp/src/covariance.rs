@@ -5,11 +5,18 @@
 //! `(x, y, θ)`), and the information matrix is `I = Σ J_iᵀ J_i` — the Gauss–Newton
 //! Hessian of the point-to-line cost. With the weights `w_i` of the step
 //! (inverse residual variances up to a common factor σ̂²), `I = Σ w_i J_iᵀ J_i` and the
-//! covariance is `σ̂² I⁻¹`, `σ̂² = Σ w_i e_i² / (m − 3)`. This is the first-order estimate
-//! for independent residuals; it does not propagate the noise of the reference
-//! points through the local lines (Censi's ICRA 2007 closed form does), and it is
-//! optimistic when the range noise is correlated along the scan (see
-//! `docs/benchmarks.md` for the ratio measured against the empirical scatter).
+//! first-order covariance is `σ̂² I⁻¹`, `σ̂² = Σ w_i e_i² / (m − 3)` — the estimate
+//! for independent residuals (it does not propagate the noise of the reference points
+//! through the local lines, as Censi's ICRA 2007 closed form does).
+//!
+//! Residuals of neighbouring rays are not independent: the range noise of a real
+//! sensor is correlated over a few rays, and neighbouring matches share the local
+//! line they are measured against. The covariance is therefore multiplied by the
+//! variance inflation factor `1 + 2 Σ_k ρ_k` of the residual sequence, with `ρ_k` the
+//! autocorrelation of the weighted residuals `√w_i e_i` at lag `k` rays, estimated
+//! from the match itself and summed over the initial positive lags (k ≤ 8). For
+//! independent residuals it is ≈ 1. See `docs/benchmarks.md` for the ratio of the
+//! reported to the empirical scatter.
 //!
 //! Conditioning is judged on the information matrix with the rotation scaled by the
 //! RMS distance `ρ` of the used points (so all three axes are lengths):
@@ -25,6 +32,58 @@ pub(crate) struct Uncertainty {
     pub condition_number: f64,
     pub weakest_direction: [f64; 3],
     pub residual_sigma: f64,
+    pub inflation: f64,
+}
+
+/// Condition number of the scale-normalised information matrix and its least
+/// constrained direction `(x, y, ρθ)` (unit vector).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Conditioning {
+    pub condition_number: f64,
+    pub weakest_direction: [f64; 3],
+}
+
+/// Conditioning of the information matrix `info` in `(x, y, θ)`, with the rotation
+/// scaled by `rho` (m) so that the three axes are lengths.
+pub(crate) fn conditioning(info: &[[f64; 3]; 3], rho: f64) -> Option<Conditioning> {
+    let rho = if rho.is_finite() && rho > 1e-6 {
+        rho
+    } else {
+        1.0
+    };
+    let d = [1.0, 1.0, 1.0 / rho];
+    let scaled = Matrix3::from_fn(|r, c| d[r] * info[r][c] * d[c]);
+    if !scaled.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    let eig = SymmetricEigen::new(scaled);
+    let (imin, imax) = extreme_indices(&eig);
+    let lmin = eig.eigenvalues[imin].max(0.0);
+    let lmax = eig.eigenvalues[imax];
+    let condition_number = if lmin > 0.0 {
+        lmax / lmin
+    } else {
+        f64::INFINITY
+    };
+    let v = eig.eigenvectors.column(imin);
+    Some(Conditioning {
+        condition_number,
+        weakest_direction: [v[0], v[1], v[2]],
+    })
+}
+
+/// Indices of the smallest and largest eigenvalues.
+fn extreme_indices(eig: &SymmetricEigen<f64, nalgebra::U3>) -> (usize, usize) {
+    let (mut imin, mut imax) = (0, 0);
+    for k in 1..3 {
+        if eig.eigenvalues[k] < eig.eigenvalues[imin] {
+            imin = k;
+        }
+        if eig.eigenvalues[k] > eig.eigenvalues[imax] {
+            imax = k;
+        }
+    }
+    (imin, imax)
 }
 
 /// Accumulates `I = Σ JᵀJ` and the residual sum of squares at a pose.
@@ -36,7 +95,15 @@ pub(crate) struct InformationSum {
     sum_sq: f64,
     sum_r2: f64,
     count: usize,
+    /// The last few (ray index, weighted residual), for the autocorrelation.
+    recent: [(i64, f64); MAX_LAG],
+    /// Σ r_i r_{i−k} and the number of such pairs, per lag k (index k − 1).
+    lag_sum: [f64; MAX_LAG],
+    lag_count: [usize; MAX_LAG],
 }
+
+/// Largest lag (rays) of the residual autocorrelation.
+const MAX_LAG: usize = 8;
 
 impl InformationSum {
     /// Empty sums at `pose`.
@@ -49,19 +116,29 @@ impl InformationSum {
             sum_sq: 0.0,
             sum_r2: 0.0,
             count: 0,
+            recent: [(i64::MIN, 0.0); MAX_LAG],
+            lag_sum: [0.0; MAX_LAG],
+            lag_count: [0; MAX_LAG],
         }
     }
 
-    /// Adds a used correspondence: current point `q`, reference line normal, residual
-    /// and weight (inverse residual variance up to the common factor σ̂²).
-    pub fn add(&mut self, q: [f64; 2], normal: [f64; 2], residual: f64, w: f64) {
+    /// Adds a used correspondence: current point `q` (ray `ray`, added in increasing
+    /// ray order), reference line normal, residual and weight (inverse residual
+    /// variance up to the common factor σ̂²).
+    pub fn add(&mut self, ray: usize, q: [f64; 2], normal: [f64; 2], residual: f64, w: f64) {
+        let r = w.sqrt() * residual;
+        let ray = ray as i64;
+        for &(previous, r_previous) in &self.recent {
+            let lag = ray.wrapping_sub(previous);
+            if (1..=MAX_LAG as i64).contains(&lag) {
+                self.lag_sum[lag as usize - 1] += r * r_previous;
+                self.lag_count[lag as usize - 1] += 1;
+            }
+        }
+        self.recent[self.count % MAX_LAG] = (ray, r);
         let (s, c) = (self.sin, self.cos);
         let dq = [-s * q[0] - c * q[1], c * q[0] - s * q[1]];
-        let j = nalgebra::Vector3::new(
-            normal[0],
-            normal[1],
-            normal[0] * dq[0] + normal[1] * dq[1],
-        );
+        let j = nalgebra::Vector3::new(normal[0], normal[1], normal[0] * dq[0] + normal[1] * dq[1]);
         self.info += (w * j) * j.transpose();
         self.sum_sq += w * residual * residual;
         self.sum_r2 += q[0] * q[0] + q[1] * q[1];
@@ -73,10 +150,30 @@ impl InformationSum {
         self.count
     }
 
+    /// Variance inflation factor `1 + 2 Σ ρ_k` over the initial positive lags.
+    pub fn inflation(&self) -> f64 {
+        let variance = self.sum_sq / self.count.max(1) as f64;
+        if variance.is_nan() || variance <= 0.0 {
+            return 1.0;
+        }
+        let mut factor = 1.0;
+        for k in 0..MAX_LAG {
+            if self.lag_count[k] < 10 {
+                break;
+            }
+            let rho = self.lag_sum[k] / self.lag_count[k] as f64 / variance;
+            if rho.is_nan() || rho <= 0.0 {
+                break;
+            }
+            factor += 2.0 * rho.min(1.0);
+        }
+        factor
+    }
+
     /// Covariance and conditioning; `None` when the sums are not finite.
     pub fn finish(&self) -> Option<Uncertainty> {
         let m = self.count;
-        let sigma2 = self.sum_sq / (m.saturating_sub(3).max(1)) as f64;
+        let sigma2 = self.sum_sq / (m.saturating_sub(3).max(1)) as f64 * self.inflation();
         let rho = (self.sum_r2 / m.max(1) as f64).sqrt().max(1e-6);
         let d = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 1.0 / rho));
         let scaled = d * self.info * d;
@@ -84,18 +181,14 @@ impl InformationSum {
             return None;
         }
         let eig = SymmetricEigen::new(scaled);
-        let (mut imin, mut imax) = (0, 0);
-        for k in 1..3 {
-            if eig.eigenvalues[k] < eig.eigenvalues[imin] {
-                imin = k;
-            }
-            if eig.eigenvalues[k] > eig.eigenvalues[imax] {
-                imax = k;
-            }
-        }
+        let (imin, imax) = extreme_indices(&eig);
         let lmin = eig.eigenvalues[imin].max(0.0);
         let lmax = eig.eigenvalues[imax];
-        let condition_number = if lmin > 0.0 { lmax / lmin } else { f64::INFINITY };
+        let condition_number = if lmin > 0.0 {
+            lmax / lmin
+        } else {
+            f64::INFINITY
+        };
         let v = eig.eigenvectors.column(imin);
         let weakest_direction = [v[0], v[1], v[2]];
         // Covariance: σ̂² I⁻¹ = σ̂² D (DID)⁻¹ D, inverted in the eigenbasis so that a
@@ -125,7 +218,8 @@ impl InformationSum {
             covariance,
             condition_number,
             weakest_direction,
-            residual_sigma: sigma2.sqrt(),
+            residual_sigma: (self.sum_sq / (m.saturating_sub(3).max(1)) as f64).sqrt(),
+            inflation: self.inflation(),
         })
     }
 }

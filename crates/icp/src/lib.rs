@@ -43,4 +43,3 @@ pub use error::IcpError;
 pub use matcher::{IcpResult, Matcher};
 pub use params::{IcpParams, NeighbourSearch};
 pub use preprocess::PreparedScan;
-

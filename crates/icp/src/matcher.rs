@@ -1,11 +1,32 @@
 //! The ICP loop: correspondences, trimming, exact step, until the estimate settles.
 
 use crate::correspondence::{nearest_by_angle, nearest_by_tree, segment_for};
-use crate::covariance::InformationSum;
+use crate::covariance::{conditioning, InformationSum};
 use crate::solve_step::NormalEquations;
 use crate::trimming::threshold;
 use crate::{IcpError, IcpParams, NeighbourSearch, PreparedScan};
 use odocal_geom::{wrap_angle, Pose2};
+
+/// `next` moved back so that the step from `estimate` has no component along the
+/// unit direction `weak` of `(x, y, ρθ)`.
+fn without_component(estimate: &Pose2, next: &Pose2, weak: [f64; 3], rho: f64) -> Pose2 {
+    let rho = if rho.is_finite() && rho > 1e-6 {
+        rho
+    } else {
+        1.0
+    };
+    let d = [
+        next.x - estimate.x,
+        next.y - estimate.y,
+        rho * wrap_angle(next.theta - estimate.theta),
+    ];
+    let along = d[0] * weak[0] + d[1] * weak[1] + d[2] * weak[2];
+    Pose2::new(
+        estimate.x + d[0] - along * weak[0],
+        estimate.y + d[1] - along * weak[1],
+        estimate.theta + (d[2] - along * weak[2]) / rho,
+    )
+}
 
 /// Outcome of a successful match.
 #[derive(Debug, Clone, PartialEq)]
@@ -20,8 +41,11 @@ pub struct IcpResult {
     pub correspondences: usize,
     /// Mean absolute point-to-line residual of the used correspondences (m).
     pub mean_residual: f64,
-    /// Residual standard deviation σ̂ that scales the covariance (m).
+    /// Weighted residual standard deviation σ̂ (m, for a head-on ray).
     pub residual_sigma: f64,
+    /// Variance inflation factor applied to the covariance for the correlation of
+    /// neighbouring residuals (≈ 1 for independent noise).
+    pub residual_correlation_inflation: f64,
     /// Condition number of the scale-normalised information matrix.
     pub condition_number: f64,
     /// True when `condition_number > max_condition_number`: some direction (see
@@ -147,7 +171,11 @@ impl Matcher {
             let mut equations = NormalEquations::new();
             let mut used = 0;
             let mut fingerprint = 0xcbf2_9ce4_8422_2325u64;
-            for c in self.correspondences.iter().filter(|c| c.normalized_sq <= tau_sq) {
+            for c in self
+                .correspondences
+                .iter()
+                .filter(|c| c.normalized_sq <= tau_sq)
+            {
                 equations.add(c.q, c.normal, c.offset, c.weight);
                 used += 1;
                 fingerprint = (fingerprint ^ c.key).wrapping_mul(0x0000_0100_0000_01b3);
@@ -159,18 +187,32 @@ impl Matcher {
                     iteration: iterations,
                 });
             }
-            let next = equations.solve(&estimate).ok_or(IcpError::Numerical {
+            let mut next = equations.solve(&estimate).ok_or(IcpError::Numerical {
                 iteration: iterations,
                 what: "singular or non-finite point-to-line step",
             })?;
+            // Degeneracy: along a direction the scans hardly constrain (a corridor),
+            // the step would only follow noise. Keep the estimate there as it is —
+            // i.e. at the first guess — and move only along the others.
+            let (info, rho) = equations.information(estimate.theta);
+            if let Some(cond) = conditioning(&info, rho) {
+                if cond.condition_number.is_nan()
+                    || cond.condition_number > params.max_condition_number
+                {
+                    next = without_component(&estimate, &next, cond.weakest_direction, rho);
+                }
+            }
             let step = estimate.between(&next);
             let step_xy = step.translation_norm();
             let step_theta = step.theta.abs();
             last_step = (step_xy, step_theta);
-            if std::env::var("ICP_DEBUG").is_ok() { eprintln!("it {iterations} found {found} used {used} tau {tau:.2e} step {step_xy:.2e} {step_theta:.2e} est {next}"); }
+            if std::env::var("ICP_DEBUG").is_ok() {
+                eprintln!("it {iterations} found {found} used {used} tau {tau:.2e} step {step_xy:.2e} {step_theta:.2e} est {next}");
+            }
             estimate = next;
             previous_motion = Some(step_xy + rho_max * step_theta);
-            if step_xy <= params.epsilon_xy && step_theta <= params.epsilon_theta && !motion_limited {
+            if step_xy <= params.epsilon_xy && step_theta <= params.epsilon_theta && !motion_limited
+            {
                 converged = true;
                 break;
             }
@@ -208,7 +250,10 @@ impl Matcher {
             }
         }
         let correction = first_guess.between(&estimate);
-        let (linear, angular) = (correction.translation_norm(), wrap_angle(correction.theta).abs());
+        let (linear, angular) = (
+            correction.translation_norm(),
+            wrap_angle(correction.theta).abs(),
+        );
         if linear > params.max_linear_correction || angular > params.max_angular_correction {
             return Err(IcpError::CorrectionTooLarge {
                 linear,
@@ -230,14 +275,24 @@ impl Matcher {
         let mut info = InformationSum::new(&estimate);
         let (s, c) = estimate.theta.sin_cos();
         let mut sum_abs = 0.0;
-        for k in self.correspondences.iter().filter(|k| k.normalized_sq <= tau_sq) {
+        for k in self
+            .correspondences
+            .iter()
+            .filter(|k| k.normalized_sq <= tau_sq)
+        {
             let p = [
                 estimate.x + c * k.q[0] - s * k.q[1],
                 estimate.y + s * k.q[0] + c * k.q[1],
             ];
             let e = k.normal[0] * p[0] + k.normal[1] * p[1] - k.offset;
             sum_abs += e.abs();
-            info.add(k.q, k.normal, e, k.weight);
+            info.add(
+                current.valid_indices[(k.key >> 32) as usize] as usize,
+                k.q,
+                k.normal,
+                e,
+                k.weight,
+            );
         }
         let used = info.count();
         let unc = info.finish().ok_or(IcpError::Numerical {
@@ -251,8 +306,10 @@ impl Matcher {
             correspondences: used,
             mean_residual: sum_abs / used.max(1) as f64,
             residual_sigma: unc.residual_sigma,
+            residual_correlation_inflation: unc.inflation,
             condition_number: unc.condition_number,
-            ill_conditioned: !(unc.condition_number <= params.max_condition_number),
+            ill_conditioned: unc.condition_number.is_nan()
+                || unc.condition_number > params.max_condition_number,
             weakest_direction: unc.weakest_direction,
         })
     }
@@ -293,7 +350,11 @@ impl Matcher {
                 // current scan alone, so that a correspondence's weight never depends
                 // on the estimate), or of the reference rays when unknown.
                 let own = current.incidence_cos[i as usize];
-                let cos_cur = if own.is_nan() { line.incidence_cos } else { own };
+                let cos_cur = if own.is_nan() {
+                    line.incidence_cos
+                } else {
+                    own
+                };
                 let floor = self.params.min_incidence_cos;
                 1.0 / (cos_cur * cos_cur
                     + self.params.reference_noise_share * line.incidence_cos * line.incidence_cos

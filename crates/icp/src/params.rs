@@ -122,14 +122,11 @@ impl IcpParams {
         if self.max_iterations == 0 {
             return bad("max_iterations must be at least 1");
         }
-        if !(self.epsilon_xy.is_finite() && self.epsilon_xy >= 0.0)
-            || !(self.epsilon_theta.is_finite() && self.epsilon_theta >= 0.0)
-        {
+        let non_negative = |v: f64| v.is_finite() && v >= 0.0;
+        if !non_negative(self.epsilon_xy) || !non_negative(self.epsilon_theta) {
             return bad("epsilon_xy and epsilon_theta must be finite and non-negative");
         }
-        if !(self.settle_xy.is_finite() && self.settle_xy >= 0.0)
-            || !(self.settle_theta.is_finite() && self.settle_theta >= 0.0)
-        {
+        if !non_negative(self.settle_xy) || !non_negative(self.settle_theta) {
             return bad("settle_xy and settle_theta must be finite and non-negative");
         }
         if !positive(self.max_correspondence_dist) {

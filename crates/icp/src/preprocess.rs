@@ -48,8 +48,6 @@ pub struct PreparedScan {
     pub(crate) points: Vec<[f64; 2]>,
     /// Validity of each reading.
     pub(crate) valid: Vec<bool>,
-    /// `1 / range` of each reading (0 where invalid).
-    pub(crate) inv_ranges: Vec<f64>,
     /// |cos| of the incidence angle of each ray on its own surface (mean over the
     /// usable segments at the point), NaN when the point has no usable segment.
     pub(crate) incidence_cos: Vec<f64>,
@@ -169,7 +167,6 @@ impl PreparedScan {
             rays,
             points,
             valid,
-            inv_ranges,
             incidence_cos,
             valid_indices,
             segments,
@@ -341,7 +338,8 @@ fn local_lines(
                 if best.rms <= params.max_line_fit_rms && best.line.normal[0].is_finite() {
                     let mut line = best.line;
                     let n = line.normal;
-                    let cos = |k: usize| (n[0] * points[k][0] + n[1] * points[k][1]) * inv_ranges[k];
+                    let cos =
+                        |k: usize| (n[0] * points[k][0] + n[1] * points[k][1]) * inv_ranges[k];
                     line.incidence_cos = 0.5 * (cos(i) + cos(i + 1)).abs();
                     *segment = Some(line);
                 }
@@ -476,7 +474,10 @@ mod tests {
         // Segments touching invalid readings are unusable; the wall x = 1 elsewhere.
         assert!(scan.segments[2].is_none() && scan.segments[7].is_none());
         let line = scan.segments[20].expect("segment on the wall");
-        assert!((line.normal[0] + 1.0).abs() < 1e-9 && (line.offset + 1.0).abs() < 1e-6, "{line:?}");
+        assert!(
+            (line.normal[0] + 1.0).abs() < 1e-9 && (line.offset + 1.0).abs() < 1e-6,
+            "{line:?}"
+        );
     }
 
     #[test]

@@ -39,13 +39,33 @@ impl NormalEquations {
     pub fn add(&mut self, q: [f64; 2], normal: [f64; 2], offset: f64, w: f64) {
         let [nx, ny] = normal;
         let a = [nx, ny, nx * q[0] + ny * q[1], ny * q[0] - nx * q[1]];
-        for r in 0..4 {
-            let wa = w * a[r];
-            for c in r..4 {
-                self.h[r][c] += wa * a[c];
+        for (r, &ar) in a.iter().enumerate() {
+            let wa = w * ar;
+            for (h, &ac) in self.h[r].iter_mut().zip(&a).skip(r) {
+                *h += wa * ac;
             }
             self.g[r] += wa * offset;
         }
+    }
+
+    /// The Gauss–Newton information matrix `Σ w JᵀJ` in `(x, y, θ)` at rotation `theta`
+    /// (`J = [n_x, n_y, nᵀR'(θ)q]` is a linear map of the accumulated vector `a`), and
+    /// the weighted RMS distance of the points from the sensor.
+    pub fn information(&self, theta: f64) -> ([[f64; 3]; 3], f64) {
+        let h = &self.h;
+        let (s, c) = theta.sin_cos();
+        // Row 3 of the map: (0, 0, −s, c).
+        let i02 = -s * h[0][2] + c * h[0][3];
+        let i12 = -s * h[1][2] + c * h[1][3];
+        let i22 = s * s * h[2][2] - 2.0 * s * c * h[2][3] + c * c * h[3][3];
+        let info = [
+            [h[0][0], h[0][1], i02],
+            [h[0][1], h[1][1], i12],
+            [i02, i12, i22],
+        ];
+        let weight = h[0][0] + h[1][1];
+        let rho = ((h[2][2] + h[3][3]) / weight).sqrt();
+        (info, rho)
     }
 
     /// The pose minimising the cost; `previous` anchors unconstrained directions.
@@ -64,7 +84,7 @@ impl NormalEquations {
         let gr = [self.g[2], self.g[3]];
 
         let det = a[0][0] * a[1][1] - a[0][1] * a[0][1];
-        if !(det > 0.0) {
+        if det.is_nan() || det <= 0.0 {
             return None;
         }
         let ai = [

@@ -71,10 +71,14 @@ mod tests {
 
     #[test]
     fn gross_outliers_are_cut_and_inliers_kept() {
-        let mut params = IcpParams::default();
-        params.trim_fraction = 1.0;
+        let params = IcpParams {
+            trim_fraction: 1.0,
+            ..IcpParams::default()
+        };
         // 90 inliers spread ~1 mm, 10 outliers at 5 cm.
-        let mut r: Vec<f64> = (0..90).map(|i| (0.001 * ((i % 9) as f64 / 4.0)).powi(2)).collect();
+        let mut r: Vec<f64> = (0..90)
+            .map(|i| (0.001 * ((i % 9) as f64 / 4.0)).powi(2))
+            .collect();
         r.extend(std::iter::repeat_n(0.05f64.powi(2), 10));
         let (tau, _) = threshold(&mut r.clone(), &params, Some(1e-6), f64::INFINITY);
         assert!(tau > 0.002 && tau < 0.05, "tau = {tau}");
@@ -82,8 +86,10 @@ mod tests {
 
     #[test]
     fn fraction_and_monotonicity() {
-        let mut params = IcpParams::default();
-        params.trim_fraction = 0.9;
+        let params = IcpParams {
+            trim_fraction: 0.9,
+            ..IcpParams::default()
+        };
         let r: Vec<f64> = (1..=100).map(|i| (i as f64 * 1e-3).powi(2)).collect();
         // A large motion would allow everything; the fraction keeps 90 of 100.
         let (tau, _) = threshold(&mut r.clone(), &params, Some(1.0), f64::INFINITY);

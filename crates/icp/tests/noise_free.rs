@@ -18,16 +18,27 @@ fn recover_grid(search: NeighbourSearch) {
     let mut total_iterations = 0;
     let mut count = 0;
     for &origin in &[Pose2::new(0.1, -0.2, 0.3), Pose2::new(-0.4, 0.5, -2.0)] {
-        let reference = PreparedScan::new(&exact(&world.scan(&origin, &angles)), &angles, 0.02, 4.0, &params)
-            .expect("reference");
+        let reference = PreparedScan::new(
+            &exact(&world.scan(&origin, &angles)),
+            &angles,
+            0.02,
+            4.0,
+            &params,
+        )
+        .expect("reference");
         for &dx in &[-0.05, -0.02, 0.0, 0.03, 0.05] {
             for &dy in &[-0.05, 0.0, 0.02, 0.05] {
                 for &dth_deg in &[-10.0, -4.0, 0.0, 3.0, 10.0] {
                     let truth = Pose2::new(dx, dy, f64::to_radians(dth_deg));
                     let pose = origin.compose(&truth);
-                    let current =
-                        PreparedScan::new(&exact(&world.scan(&pose, &angles)), &angles, 0.02, 4.0, &params)
-                            .expect("current");
+                    let current = PreparedScan::new(
+                        &exact(&world.scan(&pose, &angles)),
+                        &angles,
+                        0.02,
+                        4.0,
+                        &params,
+                    )
+                    .expect("current");
                     let result = matcher
                         .match_scans(&reference, &current, Pose2::IDENTITY)
                         .unwrap_or_else(|e| panic!("{truth} from {origin}: {e}"));
