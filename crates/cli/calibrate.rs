@@ -47,6 +47,10 @@ pub struct Args {
     /// Use the constant-speed formulas instead of the encoder profile.
     #[arg(long)]
     pub constant_speed: bool,
+    /// Weight each sample by the scan matcher's covariance of ŝ (default: noise
+    /// estimated from the residuals, which is what the reported σ assume).
+    #[arg(long)]
+    pub icp_covariance: bool,
     /// Estimate a constant clock offset between laser and encoders (within ±0.5 s).
     #[arg(long)]
     pub estimate_time_offset: bool,
@@ -156,6 +160,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ticks_per_revolution: args.ticks_per_rev,
         stride: args.stride,
         use_profile: !args.constant_speed,
+        use_icp_covariance: args.icp_covariance,
         time_offset: args.time_offset,
         estimate_time_offset: args.estimate_time_offset.then_some(0.5),
         second_pass: args.second_pass,

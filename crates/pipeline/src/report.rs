@@ -93,6 +93,8 @@ pub struct Settings {
     pub refine: bool,
     /// Encoder profile (non-constant speeds) used.
     pub use_profile: bool,
+    /// ŝ weighted by the scan matcher's covariance.
+    pub use_icp_covariance: bool,
     /// Second matching pass.
     pub second_pass: bool,
     /// Clock offset applied when not estimated (s).
@@ -147,6 +149,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             trim: opts.solve.trim,
             refine: opts.solve.refine,
             use_profile: opts.use_profile,
+            use_icp_covariance: opts.use_icp_covariance,
             second_pass: opts.second_pass,
             time_offset_s: opts.time_offset,
         },
