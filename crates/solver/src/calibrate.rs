@@ -3,7 +3,7 @@
 
 use crate::covariance::{invert_information, Inversion};
 use crate::error::SolveError;
-use crate::kinematics::{residual_of, Predictor};
+use crate::kinematics::{residual_of, Predictor, RawOdometry};
 use crate::noise::{residual_sigmas, NoiseWeights};
 use crate::normal_equations::accumulate;
 use crate::observability::{
@@ -133,14 +133,29 @@ pub fn closed_form(samples: &[Sample], use_profile: bool) -> Result<ClosedForm, 
     for (k, s) in samples.iter().enumerate() {
         s.check(k)?;
     }
-    closed_form_packed(&Packed::all(samples, use_profile), None).map(|(cf, _)| cf)
+    closed_form_packed(
+        &Packed::all(samples, use_profile),
+        None,
+        &mut Scratch::default(),
+    )
 }
 
-/// Closed form on packed samples; also returns the residuals `ŝ_pred − ŝ`.
+/// Buffers reused by the closed-form solves of successive trimming rounds.
+#[derive(Default)]
+struct Scratch {
+    /// Per-sample odometry for `b = 1`.
+    unit: Vec<RawOdometry>,
+    /// Residuals `ŝ_pred − ŝ` of the last solve.
+    residuals: Vec<[f64; 3]>,
+}
+
+/// Closed form on packed samples; leaves the residuals `ŝ_pred − ŝ` in
+/// `scratch.residuals`.
 fn closed_form_packed(
     samples: &[Packed],
     theta_weights: Option<&[f64]>,
-) -> Result<(ClosedForm, Vec<[f64; 3]>), SolveError> {
+    scratch: &mut Scratch,
+) -> Result<ClosedForm, SolveError> {
     let s1 = step1(samples, theta_weights);
     if s1.condition.is_nan()
         || s1.condition > STEP1_SINGULAR_CONDITION
@@ -149,7 +164,7 @@ fn closed_form_packed(
     {
         return Err(step1_not_excited(samples, &s1));
     }
-    let (m, unit) = build_m(samples, s1.j21, s1.j22);
+    let m = build_m(samples, s1.j21, s1.j22, &mut scratch.unit);
     let s2 = match solve_m(&m) {
         Some(s2) if s2.a_condition_scaled <= A_SINGULAR_CONDITION && s2.b > 0.0 => s2,
         Some(s2) => {
@@ -169,19 +184,17 @@ fn closed_form_packed(
     };
     // Residuals ŝ_pred − ŝ from the cached unit odometry: o = (b·c_x, b·c_y, oθ).
     let pred = Predictor::new(&params, true);
-    let residuals = samples
-        .iter()
-        .zip(&unit)
-        .map(|(s, u)| residual_of(pred.sensor_from_odometry(&u.scale_translation(s2.b)), &s.sm))
-        .collect();
-    Ok((
-        ClosedForm {
-            params,
-            step1: s1,
-            step2: s2,
-        },
-        residuals,
-    ))
+    scratch.residuals.clear();
+    scratch.residuals.extend(
+        samples.iter().zip(&scratch.unit).map(|(s, u)| {
+            residual_of(pred.sensor_from_odometry(&u.scale_translation(s2.b)), &s.sm)
+        }),
+    );
+    Ok(ClosedForm {
+        params,
+        step1: s1,
+        step2: s2,
+    })
 }
 
 /// Calibrates: the six parameters, their covariance and the observability report.
@@ -210,16 +223,18 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
 
     let mut active = Packed::all(samples, options.use_profile);
     let mut samples_per_round = vec![active.len()];
-    let (mut cf, mut residuals) = closed_form_packed(&active, tw)?;
+    let mut scratch = Scratch::default();
+    let mut cf = closed_form_packed(&active, tw, &mut scratch)?;
     // Scan-matching noise as the original package estimates it: residuals of the
     // first (untrimmed) closed-form estimate over the samples kept after the first
     // trimming round (all samples when there is no trimming).
     let mut noise_residuals: Option<Vec<[f64; 3]>> = None;
     for round in 0..options.trim.rounds() {
-        let keep = options.trim.keep(&residuals);
+        let keep = options.trim.keep(&scratch.residuals);
         if round == 0 {
             noise_residuals = Some(
-                residuals
+                scratch
+                    .residuals
                     .iter()
                     .zip(&keep)
                     .filter(|(_, &k)| k)
@@ -237,13 +252,13 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
                 stage: format!("after trimming round {}", round + 1),
             });
         }
-        (cf, residuals) = closed_form_packed(&active, tw)?;
+        cf = closed_form_packed(&active, tw, &mut scratch)?;
     }
     let sm_sigma = match options.sigma_from {
         SigmaEstimate::FirstRound => {
-            residual_sigmas(noise_residuals.as_deref().unwrap_or(&residuals))
+            residual_sigmas(noise_residuals.as_deref().unwrap_or(&scratch.residuals))
         }
-        SigmaEstimate::FinalSet => residual_sigmas(&residuals),
+        SigmaEstimate::FinalSet => residual_sigmas(&scratch.residuals),
     };
 
     let (weights, noise_source) = match sample_weights {

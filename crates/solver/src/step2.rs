@@ -37,12 +37,18 @@ pub const A_SINGULAR_CONDITION: f64 = 1e12;
 /// Builds `M` over `samples` for the given `J21`, `J22` and returns it with the
 /// per-sample odometry for `b = 1` (`c_x`, `c_y`, `oθ`; same order as `samples`),
 /// so that the robot displacement is `(b·c_x, b·c_y, oθ)`.
-pub(crate) fn build_m(samples: &[Packed], j21: f64, j22: f64) -> ([[f64; 5]; 5], Vec<RawOdometry>) {
+pub(crate) fn build_m(
+    samples: &[Packed],
+    j21: f64,
+    j22: f64,
+    unit: &mut Vec<RawOdometry>,
+) -> [[f64; 5]; 5] {
     // With r1 = [−c_x, 1−cos, sin, ŝx, −ŝy] and r2 = [−c_y, −sin, 1−cos, ŝy, ŝx],
     // r1ᵀr1 + r2ᵀr2 has M11 = M22 = 2(1 − cos), M12 = M34 = 0, M33 = M44; the other
     // entries are the eleven sums below.
     let mut sum = [0.0; 11];
-    let mut unit = Vec::with_capacity(samples.len());
+    unit.clear();
+    unit.reserve(samples.len());
     for s in samples {
         let o = odometry_raw(-j21, j22, 1.0, s.pieces());
         unit.push(o);
@@ -68,7 +74,7 @@ pub(crate) fn build_m(samples: &[Packed], j21: f64, j22: f64) -> ([[f64; 5]; 5],
         [sum[3], sum[6], sum[8], sum[10], 0.0],
         [sum[4], sum[7], sum[9], 0.0, sum[10]],
     ];
-    (m, unit)
+    m
 }
 
 /// Minimises `xᵀMx` subject to `x4² + x5² = 1`, `x1 > 0`. Returns `None` only
@@ -133,7 +139,7 @@ mod tests {
         .collect();
         let packed = Packed::all(&samples, true);
         let (j21, j22) = (-0.2, 0.19);
-        let (m, _) = build_m(&packed, j21, j22);
+        let m = build_m(&packed, j21, j22, &mut Vec::new());
         let mut want = [[0.0; 5]; 5];
         for s in &packed {
             let o = odometry_raw(-j21, j22, 1.0, s.pieces());
@@ -173,7 +179,12 @@ mod tests {
             })
             .collect();
         let j = truth.j();
-        let (m, _) = build_m(&Packed::all(&samples, true), j[1][0], j[1][1]);
+        let m = build_m(
+            &Packed::all(&samples, true),
+            j[1][0],
+            j[1][1],
+            &mut Vec::new(),
+        );
         let s2 = solve_m(&m).unwrap();
         assert!((s2.b - truth.b).abs() < 1e-12);
         assert!((s2.laser.x - truth.laser.x).abs() < 1e-12);

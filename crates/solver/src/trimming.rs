@@ -70,16 +70,14 @@ pub fn tro_keep(residuals: &[[f64; 3]], p: f64) -> Vec<bool> {
     }
     let index = (((1.0 - p) * n as f64).round() as usize).min(n - 1);
     // Squared |e_xy|: same order, no square root.
-    let xy: Vec<f64> = residuals
+    let xy2 = |e: &[f64; 3]| e[0] * e[0] + e[1] * e[1];
+    let mut xy: Vec<f64> = residuals.iter().map(xy2).collect();
+    let mut th: Vec<f64> = residuals.iter().map(|e| e[2].abs()).collect();
+    let t_xy = order_statistic(&mut xy, index);
+    let t_th = order_statistic(&mut th, index);
+    residuals
         .iter()
-        .map(|e| e[0] * e[0] + e[1] * e[1])
-        .collect();
-    let th: Vec<f64> = residuals.iter().map(|e| e[2].abs()).collect();
-    let t_xy = order_statistic(&mut xy.clone(), index);
-    let t_th = order_statistic(&mut th.clone(), index);
-    xy.iter()
-        .zip(&th)
-        .map(|(&a, &b)| a <= t_xy && b <= t_th)
+        .map(|e| xy2(e) <= t_xy && e[2].abs() <= t_th)
         .collect()
 }
 
