@@ -67,14 +67,13 @@ pub(crate) fn build_m(
         sum[9] += omc * sx - sn * sy;
         sum[10] += sx * sx + sy * sy;
     }
-    let m = [
+    [
         [sum[0], sum[1], sum[2], sum[3], sum[4]],
         [sum[1], sum[5], 0.0, sum[6], sum[7]],
         [sum[2], 0.0, sum[5], sum[8], sum[9]],
         [sum[3], sum[6], sum[8], sum[10], 0.0],
         [sum[4], sum[7], sum[9], 0.0, sum[10]],
-    ];
-    m
+    ]
 }
 
 /// Minimises `xᵀMx` subject to `x4² + x5² = 1`, `x1 > 0`. Returns `None` only
