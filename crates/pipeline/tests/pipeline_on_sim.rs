@@ -95,3 +95,27 @@ fn results_do_not_depend_on_the_thread_count() {
     assert_eq!(one.calibration.params, two.calibration.params);
     assert_eq!(one.calibration.covariance, two.calibration.covariance);
 }
+
+#[test]
+fn odometry_first_guesses_save_icp_iterations() {
+    let (run, log) = sim(34, 60.0, 0.0);
+    let truth = odocal_solver::Params {
+        r_l: run.config.robot.r_l,
+        r_r: run.config.robot.r_r,
+        b: run.config.robot.b,
+        laser: run.config.robot.laser,
+    };
+    let mean_iterations = |opts: &Options| {
+        let mut timing = Timing::default();
+        let s = synchronize_and_match(&log, opts, &NoProgress, &mut timing).unwrap();
+        let total: u32 = s.samples.iter().map(|p| p.icp.iterations).sum();
+        total as f64 / s.samples.len() as f64
+    };
+    let identity = mean_iterations(&Options::default());
+    let guided = mean_iterations(&Options {
+        initial_params: Some(truth),
+        ..Options::default()
+    });
+    println!("mean ICP iterations: identity guess {identity:.2}, odometry guess {guided:.2}");
+    assert!(guided < identity);
+}
