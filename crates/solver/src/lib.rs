@@ -17,6 +17,26 @@
 //!    [`Observability`] report; degenerate data give [`SolveError::NotExcited`].
 //!
 //! Entry point: [`calibrate`].
+//!
+//! ```
+//! use odocal_geom::Pose2;
+//! use odocal_solver::{calibrate, Params, Predictor, Sample, SolveOptions};
+//!
+//! // A robot and a drive with straight runs, spins and arcs; ŝ predicted exactly.
+//! let truth = Params { r_l: 0.03, r_r: 0.031, b: 0.3, laser: Pose2::new(0.1, 0.02, 1.0) };
+//! let predictor = Predictor::new(&truth, true);
+//! let samples: Vec<Sample> = (0..60)
+//!     .map(|k| {
+//!         let (l, r) = [(5.0, 5.0), (-4.0, 4.0), (2.0, 6.0)][k % 3];
+//!         let s = Sample::from_rotations(0.5, l * (1.0 + 0.01 * k as f64), r, Pose2::IDENTITY);
+//!         Sample { sm: Pose2::from_array(predictor.predict(&s)), ..s }
+//!     })
+//!     .collect();
+//! let cal = calibrate(&samples, &SolveOptions::default()).unwrap();
+//! assert!((cal.params.b - 0.3).abs() < 1e-9);
+//! assert!((cal.params.laser.theta - 1.0).abs() < 1e-9);
+//! println!("{}", cal.observability.sentence);
+//! ```
 
 #![deny(missing_docs)]
 // Dense 2×2 … 6×6 numerics read best with explicit indices.
