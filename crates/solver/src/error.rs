@@ -21,7 +21,7 @@ pub enum SolveError {
     NonFinite {
         /// Index of the sample in the input slice, from 0.
         index: usize,
-        /// The offending field (e.g. "sm.theta", "dphi_l", "sm_cov[1][1]").
+        /// The offending field (e.g. `sm.theta`, `dphi_l`, `sm_cov[1][1]`).
         field: String,
         /// The value found.
         value: f64,
