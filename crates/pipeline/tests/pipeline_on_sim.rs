@@ -119,3 +119,48 @@ fn odometry_first_guesses_save_icp_iterations() {
     println!("mean ICP iterations: identity guess {identity:.2}, odometry guess {guided:.2}");
     assert!(guided < identity);
 }
+
+/// With the true sensor displacements in place of ICP's, what remains is the
+/// synchronization (interpolated ticks, profiles) and the kinematics: the parameters
+/// come back to within the encoder quantization's effect.
+#[test]
+fn true_displacements_give_back_the_parameters() {
+    let (run, log) = sim(35, 180.0, 0.0);
+    let mut timing = Timing::default();
+    let synced =
+        synchronize_and_match(&log, &Options::default(), &NoProgress, &mut timing).unwrap();
+    let scans: Vec<_> = run.logged_scans().collect();
+    let samples: Vec<odocal_solver::Sample> = synced
+        .samples
+        .iter()
+        .map(|s| {
+            let mut sample = s.to_solver(true, false);
+            sample.sm = scans[s.pair.first]
+                .sensor
+                .between(&scans[s.pair.second].sensor);
+            sample
+        })
+        .collect();
+    let opts = odocal_solver::SolveOptions {
+        trim: odocal_solver::Trim::None,
+        ..odocal_solver::SolveOptions::default()
+    };
+    let c = odocal_solver::calibrate(&samples, &opts).unwrap();
+    let r = &run.config.robot;
+    let e = c.params.difference(&odocal_solver::Params {
+        r_l: r.r_l,
+        r_r: r.r_r,
+        b: r.b,
+        laser: r.laser,
+    });
+    println!("errors with true ŝ ({} samples): {e:?}", samples.len());
+    for (i, rel) in [(0, r.r_l), (1, r.r_r), (2, r.b)] {
+        assert!(e[i].abs() < 1e-4 * rel, "parameter {i}: {}", e[i]);
+    }
+    assert!(
+        e[3].abs() < 2e-5 && e[4].abs() < 2e-5,
+        "ℓ error {:?}",
+        &e[3..5]
+    );
+    assert!(e[5].abs() < 1e-4, "ℓθ error {}", e[5]);
+}
