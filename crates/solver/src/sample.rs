@@ -136,12 +136,6 @@ impl Sample {
             }
         }
         if let Some(profile) = &self.profile {
-            if profile.is_empty() {
-                return Err(SolveError::InvalidSample {
-                    index,
-                    reason: "the wheel-speed profile is present but empty".into(),
-                });
-            }
             let (mut sum_l, mut sum_r) = (0.0, 0.0);
             for (k, p) in profile.iter().enumerate() {
                 for (field, value) in [
