@@ -176,7 +176,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let report = build_report(&args.log, &log, &opts, &outcome);
 
     if let Some(dir) = &args.out {
-        write_outputs(dir, &log, &opts, &outcome, &report, args.plots)?;
+        write_outputs(dir, &opts, &outcome, &report, args.plots)
+            .with_context(|| format!("cannot write the results into {}", dir.display()))?;
     }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

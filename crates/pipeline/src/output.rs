@@ -5,7 +5,7 @@ use crate::run::{Options, Outcome};
 use crate::samples::PairSample;
 use crate::svg::{histogram, plot, Figure, Series};
 use odocal_geom::Pose2;
-use odocal_log::{write_tuple, Log};
+use odocal_log::write_tuple;
 use odocal_solver::{Params, Predictor};
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
@@ -24,13 +24,11 @@ pub fn write_tuples(path: &Path, samples: &[PairSample]) -> io::Result<()> {
 /// (created if needed).
 pub fn write_outputs(
     dir: &Path,
-    log: &Log,
     opts: &Options,
     outcome: &Outcome,
     report: &Report,
     plots: bool,
 ) -> io::Result<()> {
-    let _ = log;
     fs::create_dir_all(dir)?;
     let json = serde_json::to_string_pretty(report).map_err(io::Error::other)?;
     fs::write(dir.join("results.json"), json + "\n")?;
