@@ -60,6 +60,26 @@ pub(crate) fn nearest_by_angle(
     };
     let mut best = max_dist2;
     let mut best_k = usize::MAX;
+    let first_ccw = (lo + 1) as usize;
+    // Fast path: the two rays on each side of p's bearing, without branches on the
+    // data; when the next rays out on both sides are already ruled out by their
+    // bound, the answer is final. Otherwise (or near the ends), the general walk.
+    if first_ccw >= 2 && first_ccw + 2 < n {
+        for (k, ray) in rays.iter().enumerate().skip(first_ccw - 2).take(4) {
+            let d2 = dist2(ray.point, p);
+            // NaN (invalid point) never compares smaller.
+            if d2 < best {
+                best = d2;
+                best_k = k;
+            }
+        }
+        let settled = first_ccw < 3 || lower_bound(rays[first_ccw - 3].dir) >= best;
+        if settled && lower_bound(rays[first_ccw + 2].dir) >= best {
+            return (best_k != usize::MAX).then_some(best_k);
+        }
+        best = max_dist2;
+        best_k = usize::MAX;
+    }
     // Clockwise from lo, then counter-clockwise from lo + 1. Invalid points are NaN,
     // whose distance never compares smaller.
     let mut visit = |k: usize| {
@@ -74,7 +94,6 @@ pub(crate) fn nearest_by_angle(
         }
         true
     };
-    let first_ccw = (lo + 1) as usize;
     for k in (0..first_ccw).rev() {
         if !visit(k) {
             break;
@@ -103,33 +122,18 @@ pub(crate) fn nearest_by_tree(
 ///
 /// Returns the segment index `i` (segment from point `i` to `i + 1`).
 pub(crate) fn segment_for(reference: &PreparedScan, p: [f64; 2], j: usize) -> Option<usize> {
-    let pts = &reference.points;
-    let pj = pts[j];
-    let e = [p[0] - pj[0], p[1] - pj[1]];
-    // Projection of p along the segment from j towards `other`, as (e·v, |v|²): the
-    // parameter is their ratio (0 at j, 1 at `other`).
-    let along = |other: usize| {
-        let v = [pts[other][0] - pj[0], pts[other][1] - pj[1]];
-        (e[0] * v[0] + e[1] * v[1], v[0] * v[0] + v[1] * v[1])
-    };
-    let forward = reference.segments[j].map(|_| along(j + 1));
-    let backward = if j > 0 {
-        reference.segments[j - 1].map(|_| along(j - 1))
+    let ray = &reference.rays[j];
+    let e = [p[0] - ray.point[0], p[1] - ray.point[1]];
+    // Distance of p's projection from point j along each usable segment (NaN when
+    // that segment is not usable: NaN never compares true).
+    let forward = e[0] * ray.to_next[0] + e[1] * ray.to_next[1];
+    let backward = e[0] * ray.to_previous[0] + e[1] * ray.to_previous[1];
+    if forward >= 0.0 && (backward.is_nan() || backward <= forward) {
+        Some(j)
+    } else if backward >= 0.0 {
+        Some(j - 1)
     } else {
         None
-    };
-    match (forward, backward) {
-        // Both sides: the one with the larger parameter f/lf ≥ b/lb (lengths > 0).
-        (Some((f, lf)), Some((b, lb))) => {
-            if f * lb >= b * lf {
-                (f >= 0.0).then_some(j)
-            } else {
-                (b >= 0.0).then(|| j - 1)
-            }
-        }
-        (Some((f, _)), None) => (f >= 0.0).then_some(j),
-        (None, Some((b, _))) => (b >= 0.0).then(|| j - 1),
-        (None, None) => None,
     }
 }
 

@@ -128,14 +128,16 @@ impl InformationSum {
     pub fn add(&mut self, ray: usize, q: [f64; 2], normal: [f64; 2], residual: f64, w: f64) {
         let r = w.sqrt() * residual;
         let ray = ray as i64;
-        for &(previous, r_previous) in &self.recent {
-            let lag = ray.wrapping_sub(previous);
-            if (1..=MAX_LAG as i64).contains(&lag) {
+        // `recent` holds the residual of ray j at slot j mod MAX_LAG.
+        for lag in 1..=MAX_LAG as i64 {
+            let (previous, r_previous) =
+                self.recent[(ray - lag).rem_euclid(MAX_LAG as i64) as usize];
+            if previous == ray - lag {
                 self.lag_sum[lag as usize - 1] += r * r_previous;
                 self.lag_count[lag as usize - 1] += 1;
             }
         }
-        self.recent[self.count % MAX_LAG] = (ray, r);
+        self.recent[ray.rem_euclid(MAX_LAG as i64) as usize] = (ray, r);
         let (s, c) = (self.sin, self.cos);
         let dq = [-s * q[0] - c * q[1], c * q[0] - s * q[1]];
         let j = nalgebra::Vector3::new(normal[0], normal[1], normal[0] * dq[0] + normal[1] * dq[1]);

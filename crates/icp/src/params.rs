@@ -86,8 +86,8 @@ impl Default for IcpParams {
     fn default() -> Self {
         IcpParams {
             max_iterations: 40,
-            epsilon_xy: 1e-5,
-            epsilon_theta: 1e-5,
+            epsilon_xy: 5e-5,
+            epsilon_theta: 5e-5,
             settle_after: 12,
             settle_xy: 5e-5,
             settle_theta: 5e-5,

@@ -35,6 +35,12 @@ pub(crate) struct Ray {
     pub dir: [f64; 2],
     /// The measured point in the sensor frame, NaN when invalid.
     pub point: [f64; 2],
+    /// Unit vector from this point to the next one when the segment between them is
+    /// usable, NaN otherwise.
+    pub to_next: [f64; 2],
+    /// Unit vector from this point to the previous one when that segment is usable,
+    /// NaN otherwise.
+    pub to_previous: [f64; 2],
 }
 
 /// A scan preprocessed once, usable as reference or as current scan any number of times.
@@ -151,10 +157,25 @@ impl PreparedScan {
                 }
             })
             .collect();
-        let rays = dirs
-            .iter()
-            .zip(&points)
-            .map(|(&dir, &point)| Ray { dir, point })
+        let unit_towards = |from: usize, to: usize| {
+            let (a, b) = (points[from], points[to]);
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let inv = 1.0 / (d[0] * d[0] + d[1] * d[1]).sqrt();
+            [d[0] * inv, d[1] * inv]
+        };
+        let rays = (0..n)
+            .map(|i| Ray {
+                dir: dirs[i],
+                point: points[i],
+                to_next: match segments[i] {
+                    Some(_) => unit_towards(i, i + 1),
+                    None => [f64::NAN; 2],
+                },
+                to_previous: match i.checked_sub(1).and_then(|k| segments[k]) {
+                    Some(_) => unit_towards(i, i - 1),
+                    None => [f64::NAN; 2],
+                },
+            })
             .collect();
         let tree = if params.search == NeighbourSearch::KdTree || !angles_increasing {
             let pts: Vec<[f64; 2]> = valid_indices.iter().map(|&i| points[i as usize]).collect();

@@ -39,12 +39,20 @@ impl NormalEquations {
     pub fn add(&mut self, q: [f64; 2], normal: [f64; 2], offset: f64, w: f64) {
         let [nx, ny] = normal;
         let a = [nx, ny, nx * q[0] + ny * q[1], ny * q[0] - nx * q[1]];
-        for (r, &ar) in a.iter().enumerate() {
-            let wa = w * ar;
-            for (h, &ac) in self.h[r].iter_mut().zip(&a).skip(r) {
-                *h += wa * ac;
-            }
-            self.g[r] += wa * offset;
+        let wa = [w * a[0], w * a[1], w * a[2], w * a[3]];
+        let h = &mut self.h;
+        h[0][0] += wa[0] * a[0];
+        h[0][1] += wa[0] * a[1];
+        h[0][2] += wa[0] * a[2];
+        h[0][3] += wa[0] * a[3];
+        h[1][1] += wa[1] * a[1];
+        h[1][2] += wa[1] * a[2];
+        h[1][3] += wa[1] * a[3];
+        h[2][2] += wa[2] * a[2];
+        h[2][3] += wa[2] * a[3];
+        h[3][3] += wa[3] * a[3];
+        for (g, wa) in self.g.iter_mut().zip(wa) {
+            *g += wa * offset;
         }
     }
 
