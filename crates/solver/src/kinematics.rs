@@ -253,7 +253,7 @@ impl Predictor {
         [
             self.cos_l * vx + self.sin_l * vy,
             -self.sin_l * vx + self.cos_l * vy,
-            wrap_angle(o.theta),
+            wrap_fast(o.theta),
         ]
     }
 
@@ -318,13 +318,30 @@ impl Predictor {
     }
 }
 
+/// [`wrap_angle`] behind an explicit in-range test, with the out-of-range case out
+/// of line: inlined, `wrap_angle`'s `rem_euclid` gets evaluated speculatively
+/// (an `fmod` call per sample in the hot loops).
+#[inline]
+pub(crate) fn wrap_fast(a: f64) -> f64 {
+    #[cold]
+    #[inline(never)]
+    fn slow(a: f64) -> f64 {
+        wrap_angle(a)
+    }
+    if a > -std::f64::consts::PI && a <= std::f64::consts::PI {
+        a
+    } else {
+        slow(a)
+    }
+}
+
 /// `predicted − measured`, angle wrapped.
 #[inline]
 pub(crate) fn residual_of(predicted: [f64; 3], measured: &[f64; 3]) -> [f64; 3] {
     [
         predicted[0] - measured[0],
         predicted[1] - measured[1],
-        wrap_angle(predicted[2] - measured[2]),
+        wrap_fast(predicted[2] - measured[2]),
     ]
 }
 
