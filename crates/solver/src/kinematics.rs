@@ -75,7 +75,8 @@ impl ArcTrig {
         let (f, g) = if x.abs() < 1e-3 {
             (sin_over_x(x), one_minus_cos_over_x(x))
         } else {
-            (sin / x, (1.0 - cos) / x)
+            let inv = 1.0 / x;
+            (sin * inv, (1.0 - cos) * inv)
         };
         ArcTrig {
             sin,
@@ -172,20 +173,21 @@ pub(crate) fn odometry_with_jacobian(
         cos: 1.0,
     };
     let mut d = [[0.0; 3]; 3];
+    let inv_b = 1.0 / b;
     for (al, ar) in pieces {
         let ds = 0.5 * (r_l * al + r_r * ar);
-        let dth = (r_r * ar - r_l * al) / b;
+        let dth = (r_r * ar - r_l * al) * inv_b;
         let d_ds = [0.5 * al, 0.5 * ar, 0.0];
-        let d_dth = [-al / b, ar / b, -dth / b];
+        let d_dth = [-al * inv_b, ar * inv_b, -dth * inv_b];
         let t = ArcTrig::new(dth);
         let (f, g) = (t.sin_over_x, t.one_minus_cos_over_x);
         let (df, dg) = if dth.abs() < SERIES_SWITCH {
             (d_sin_over_x(dth), d_one_minus_cos_over_x(dth))
         } else {
-            let x2 = dth * dth;
+            let inv_x2 = 1.0 / (dth * dth);
             (
-                (dth * t.cos - t.sin) / x2,
-                (dth * t.sin - (1.0 - t.cos)) / x2,
+                (dth * t.cos - t.sin) * inv_x2,
+                (dth * t.sin - (1.0 - t.cos)) * inv_x2,
             )
         };
         let (dx, dy) = (ds * f, ds * g);
