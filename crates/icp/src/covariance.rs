@@ -102,8 +102,9 @@ pub(crate) struct InformationSum {
     lag_count: [usize; MAX_LAG],
 }
 
-/// Largest lag (rays) of the residual autocorrelation.
+/// Largest lag (rays) of the residual autocorrelation (a power of two).
 const MAX_LAG: usize = 8;
+const LAG_MASK: i64 = MAX_LAG as i64 - 1;
 
 impl InformationSum {
     /// Empty sums at `pose`.
@@ -130,14 +131,13 @@ impl InformationSum {
         let ray = ray as i64;
         // `recent` holds the residual of ray j at slot j mod MAX_LAG.
         for lag in 1..=MAX_LAG as i64 {
-            let (previous, r_previous) =
-                self.recent[(ray - lag).rem_euclid(MAX_LAG as i64) as usize];
+            let (previous, r_previous) = self.recent[((ray - lag) & LAG_MASK) as usize];
             if previous == ray - lag {
                 self.lag_sum[lag as usize - 1] += r * r_previous;
                 self.lag_count[lag as usize - 1] += 1;
             }
         }
-        self.recent[ray.rem_euclid(MAX_LAG as i64) as usize] = (ray, r);
+        self.recent[(ray & LAG_MASK) as usize] = (ray, r);
         let (s, c) = (self.sin, self.cos);
         let dq = [-s * q[0] - c * q[1], c * q[0] - s * q[1]];
         let j = nalgebra::Vector3::new(normal[0], normal[1], normal[0] * dq[0] + normal[1] * dq[1]);

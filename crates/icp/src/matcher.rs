@@ -129,10 +129,25 @@ impl Matcher {
         // First guess of the reference ray for each current point: its bearing turned
         // by the guessed rotation (the walk then corrects for the translation).
         self.search_start.clear();
-        for &i in &current.valid_indices {
-            let bearing = current.angles[i as usize] + first_guess.theta;
-            self.search_start
-                .push(reference.ray_near_bearing(bearing) as u32);
+        match (reference.uniform, current.uniform) {
+            // Same ray geometry: the guess is a shift of the ray index.
+            (Some(r), Some(c)) if r == c => {
+                let shift = (first_guess.theta / r.1).round();
+                let last = reference.len() as f64 - 1.0;
+                self.search_start.extend(
+                    current
+                        .valid_indices
+                        .iter()
+                        .map(|&i| (i as f64 + shift).clamp(0.0, last) as u32),
+                );
+            }
+            _ => {
+                for &i in &current.valid_indices {
+                    let bearing = current.angles[i as usize] + first_guess.theta;
+                    self.search_start
+                        .push(reference.ray_near_bearing(bearing) as u32);
+                }
+            }
         }
 
         let mut estimate = first_guess;
