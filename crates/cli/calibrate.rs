@@ -3,6 +3,7 @@
 use anyhow::Context;
 use odocal_log::{read_log, Mode, ReadOptions};
 use odocal_pipeline::{build_report, calibrate_log, write_outputs, Options, Progress, Trim};
+use odocal_solver::Params;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -62,6 +63,20 @@ pub struct Args {
         allow_negative_numbers = true
     )]
     pub time_offset: f64,
+    /// Nominal parameters "r_L,r_R,b" or "r_L,r_R,b,l_x,l_y,l_theta" (m, rad): first
+    /// guesses for scan matching come from odometry with them, and the figures
+    /// compare them with the calibrated ones.
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    pub nominal: Option<Vec<f64>>,
+    /// Identity first guesses for every scan pair (default: odometry with a rough
+    /// estimate from 300 evenly spread pairs, when the log has at least 600).
+    #[arg(long)]
+    pub identity_guess: bool,
     /// Match the scans a second time, with first guesses from the first estimate.
     #[arg(long)]
     pub second_pass: bool,
@@ -136,6 +151,21 @@ pub fn thread_pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> 
         .context("cannot start the scan-matching threads")
 }
 
+/// Parameters from `--nominal`: three values (r_L, r_R, b; laser at the origin) or six.
+fn nominal_params(v: &[f64]) -> anyhow::Result<Params> {
+    let full = match v.len() {
+        3 => [v[0], v[1], v[2], 0.0, 0.0, 0.0],
+        6 => [v[0], v[1], v[2], v[3], v[4], v[5]],
+        n => anyhow::bail!(
+            "--nominal takes 3 values (r_L,r_R,b) or 6 (r_L,r_R,b,l_x,l_y,l_theta), got {n}"
+        ),
+    };
+    if !(full.iter().all(|x| x.is_finite()) && full[..3].iter().all(|x| *x > 0.0)) {
+        anyhow::bail!("--nominal needs positive radii and wheel distance and finite values");
+    }
+    Ok(Params::from_vector(full))
+}
+
 /// Runs `odocal calibrate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let pool = thread_pool(args.threads)?;
@@ -156,7 +186,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     .map_err(|e| anyhow::anyhow!("{e}"))?;
     let parse_s = t_parse.elapsed().as_secs_f64();
 
+    let initial_params = args.nominal.as_deref().map(nominal_params).transpose()?;
     let mut opts = Options {
+        initial_params,
         ticks_per_revolution: args.ticks_per_rev,
         stride: args.stride,
         use_profile: !args.constant_speed,
@@ -164,6 +196,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         time_offset: args.time_offset,
         estimate_time_offset: args.estimate_time_offset.then_some(0.5),
         second_pass: args.second_pass,
+        bootstrap_guesses: !args.identity_guess,
         accept_weak: args.accept_weak,
         ..Options::default()
     };

@@ -41,8 +41,9 @@ pub fn write_outputs(
     Ok(())
 }
 
-/// Parameters a user would start from without calibration: equal radii (the mean of
-/// the estimate), the estimated wheel distance, the laser at the robot's origin.
+/// Parameters a user would start from without calibration, when no nominal ones are
+/// given: equal radii (the mean of the estimate), the estimated wheel distance, the
+/// laser at the robot's origin.
 pub fn nominal_params(estimate: &Params) -> Params {
     let r = (estimate.r_l + estimate.r_r) / 2.0;
     Params {
@@ -123,7 +124,14 @@ pub fn figures(opts: &Options, outcome: &Outcome) -> Vec<(&'static str, String)>
     };
     out.push(("residuals_time.svg", plot(&fig, &series)));
 
-    let nominal = Predictor::new(&nominal_params(&c.params), opts.use_profile);
+    let (nominal, nominal_label) = match &opts.initial_params {
+        Some(p) => (*p, "odometry, nominal parameters"),
+        None => (
+            nominal_params(&c.params),
+            "odometry, nominal (equal radii, laser at origin)",
+        ),
+    };
+    let nominal = Predictor::new(&nominal, opts.use_profile);
     let trajectories = vec![
         Series {
             label: "scan matching".into(),
@@ -142,7 +150,7 @@ pub fn figures(opts: &Options, outcome: &Outcome) -> Vec<(&'static str, String)>
             line: true,
         },
         Series {
-            label: "odometry, nominal (equal radii, laser at origin)".into(),
+            label: nominal_label.into(),
             color: "crimson",
             points: chain(
                 samples

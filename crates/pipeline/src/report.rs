@@ -95,6 +95,9 @@ pub struct Settings {
     pub use_profile: bool,
     /// ŝ weighted by the scan matcher's covariance.
     pub use_icp_covariance: bool,
+    /// First guesses: "nominal" (given parameters), "bootstrap" (rough estimate from
+    /// a subset) or "identity".
+    pub first_guess: &'static str,
     /// Second matching pass.
     pub second_pass: bool,
     /// Clock offset applied when not estimated (s).
@@ -150,6 +153,13 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             refine: opts.solve.refine,
             use_profile: opts.use_profile,
             use_icp_covariance: opts.use_icp_covariance,
+            first_guess: if opts.initial_params.is_some() {
+                "nominal"
+            } else if opts.bootstrap_guesses {
+                "bootstrap"
+            } else {
+                "identity"
+            },
             second_pass: opts.second_pass,
             time_offset_s: opts.time_offset,
         },

@@ -15,6 +15,10 @@ use odocal_log::Log;
 use odocal_solver::{Calibration, Params, Predictor, SolveOptions, Verdict};
 use std::time::Instant;
 
+/// Pairs matched with identity first guesses to bootstrap the odometry guesses of
+/// the others (only when there are at least twice as many pairs).
+pub const BOOTSTRAP_PAIRS: usize = 300;
+
 /// Fewest samples the pipeline hands to the solver.
 pub const MIN_SAMPLES: usize = 20;
 
@@ -37,8 +41,12 @@ pub struct Options {
     pub time_offset: f64,
     /// Estimate the offset within ±this many seconds (`None`: keep `time_offset`).
     pub estimate_time_offset: Option<f64>,
-    /// Parameters for the first guess of scan matching (`None`: identity).
+    /// Parameters for the first guesses of scan matching (odometry prediction).
     pub initial_params: Option<Params>,
+    /// Without `initial_params`: match [`BOOTSTRAP_PAIRS`] evenly spread pairs with
+    /// identity guesses, solve roughly, and guess the other pairs by odometry with
+    /// that estimate (fewer ICP iterations and failures). Off: identity for all.
+    pub bootstrap_guesses: bool,
     /// Match again with first guesses predicted from the first estimate.
     pub second_pass: bool,
     /// Scan matcher settings.
@@ -60,6 +68,7 @@ impl Default for Options {
             time_offset: 0.0,
             estimate_time_offset: None,
             initial_params: None,
+            bootstrap_guesses: true,
             second_pass: false,
             icp: IcpParams::default(),
             accept_weak: false,
@@ -211,17 +220,61 @@ pub fn synchronize_and_match(
         .iter()
         .map(|(k, _)| (pairs[*k].first, pairs[*k].second))
         .collect();
-    let guesses = first_guesses(&kept, opts.initial_params.as_ref(), opts.use_profile);
     progress.start("matching", index_pairs.len());
-    let matched = match_pairs(&log.scans, &index_pairs, &guesses, &opts.icp, || {
+    let mut matched: Vec<Option<Result<MatchStats, String>>> = vec![None; kept.len()];
+    let mut guess_params = opts.initial_params;
+    if guess_params.is_none() && opts.bootstrap_guesses && kept.len() >= 2 * BOOTSTRAP_PAIRS {
+        // Match an evenly spread subset with identity guesses, solve roughly, and
+        // guess the rest by odometry with that estimate.
+        let every = kept.len() / BOOTSTRAP_PAIRS;
+        let subset: Vec<usize> = (0..kept.len()).step_by(every).collect();
+        let sub_pairs: Vec<(usize, usize)> = subset.iter().map(|&i| index_pairs[i]).collect();
+        let identity = vec![Pose2::IDENTITY; subset.len()];
+        let results = match_pairs(&log.scans, &sub_pairs, &identity, &opts.icp, || {
+            progress.advance()
+        });
+        let samples: Vec<_> = subset
+            .iter()
+            .zip(&results)
+            .filter_map(|(&i, r)| {
+                let icp = r.as_ref().ok()?.clone();
+                let s = PairSample {
+                    pair: pairs[kept[i].0],
+                    wheel: kept[i].1.clone(),
+                    icp,
+                };
+                Some(s.to_solver(opts.use_profile, false))
+            })
+            .collect();
+        let rough = SolveOptions {
+            refine: false,
+            ..opts.solve
+        };
+        guess_params = odocal_solver::calibrate(&samples, &rough)
+            .ok()
+            .map(|c| c.params)
+            .filter(|p| p.r_l > 0.0 && p.r_r > 0.0 && p.b > 0.0);
+        for (i, r) in subset.into_iter().zip(results) {
+            matched[i] = Some(r);
+        }
+    }
+    let rest: Vec<usize> = (0..kept.len()).filter(|&i| matched[i].is_none()).collect();
+    let rest_motions: Vec<(usize, WheelMotion)> =
+        rest.iter().map(|&i| (i, kept[i].1.clone())).collect();
+    let guesses = first_guesses(&rest_motions, guess_params.as_ref(), opts.use_profile);
+    let rest_pairs: Vec<(usize, usize)> = rest.iter().map(|&i| index_pairs[i]).collect();
+    let results = match_pairs(&log.scans, &rest_pairs, &guesses, &opts.icp, || {
         progress.advance()
     });
+    for (i, r) in rest.into_iter().zip(results) {
+        matched[i] = Some(r);
+    }
     progress.finish();
     timing.r#match += t_match.elapsed().as_secs_f64();
 
     let mut samples = Vec::with_capacity(kept.len());
     for ((k, wheel), m) in kept.into_iter().zip(matched) {
-        match m {
+        match m.unwrap_or_else(|| Err("not matched".into())) {
             Ok(icp) => samples.push(PairSample {
                 pair: pairs[k],
                 wheel,

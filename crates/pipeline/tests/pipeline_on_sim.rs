@@ -87,7 +87,8 @@ fn clock_offset_uses_the_simulator_sign() {
 
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
-    let (_, log) = sim(33, 90.0, 0.0);
+    // Long enough (625 pairs) for the bootstrap of the first guesses to run.
+    let (_, log) = sim(33, 250.0, 0.0);
     let opts = Options::default();
     let one = in_pool(1, || calibrate_log(&log, &opts, &NoProgress).unwrap());
     let two = in_pool(2, || calibrate_log(&log, &opts, &NoProgress).unwrap());
@@ -111,7 +112,10 @@ fn odometry_first_guesses_save_icp_iterations() {
         let total: u32 = s.samples.iter().map(|p| p.icp.iterations).sum();
         total as f64 / s.samples.len() as f64
     };
-    let identity = mean_iterations(&Options::default());
+    let identity = mean_iterations(&Options {
+        bootstrap_guesses: false,
+        ..Options::default()
+    });
     let guided = mean_iterations(&Options {
         initial_params: Some(truth),
         ..Options::default()
