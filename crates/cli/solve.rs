@@ -274,3 +274,22 @@ fn summary(args: &Args, cal: &Calibration, total: usize) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn record_to_sample_keeps_every_field() {
+        let mut rec = TupleRecord::new(0.5, 2.0, -1.0, [0.01, -0.02, 0.3]);
+        rec.sm_cov = Some([[1e-6, 0.0, 0.0], [0.0, 1e-6, 0.0], [0.0, 0.0, 1e-5]]);
+        rec.profile = Some(vec![[0.25, 0.4, -0.1], [0.25, 0.6, -0.4]]);
+        let s = sample_from_record(&rec);
+        assert_eq!((s.t, s.dphi_l, s.dphi_r), (0.5, 1.0, -0.5));
+        assert_eq!(s.sm.to_array(), [0.01, -0.02, 0.3]);
+        assert_eq!(s.sm_cov, rec.sm_cov);
+        let p = s.profile.as_ref().unwrap();
+        assert_eq!((p[1].duration, p[1].dphi_l, p[1].dphi_r), (0.25, 0.6, -0.4));
+        assert!(s.check(0).is_ok());
+    }
+}
