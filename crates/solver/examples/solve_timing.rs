@@ -39,7 +39,11 @@ fn main() {
             times.sort_by(f64::total_cmp);
             println!(
                 "{n:>7} samples, {}: min {:.3} ms, median {:.3} ms ({calls} calls)",
-                if refine { "T-RO + refinement" } else { "T-RO closed form " },
+                if refine {
+                    "T-RO + refinement"
+                } else {
+                    "T-RO closed form "
+                },
                 times[0],
                 times[calls / 2]
             );
