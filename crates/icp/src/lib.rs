@@ -3,18 +3,33 @@
 //!
 //! The pipeline, one small step per module:
 //! 1. [`PreparedScan::new`] (module `preprocess`): ranges → points, validity, runs
-//!    without range discontinuities, a fitted local line for every segment between
-//!    consecutive points. Done once per scan, reused as reference or current scan.
+//!    without range discontinuities, and for every segment between consecutive
+//!    points a *local line* (total least squares over the best-fitting window of
+//!    `line_fit_window` run points containing it). Done once per scan, reused as
+//!    reference or current scan.
 //! 2. `correspondence`: each current point ↔ the segment between its two closest
-//!    consecutive reference points (angular walk over the ordered rays, or kiddo).
-//! 3. `trimming`: adaptive outlier threshold (robust σ, previous step, fraction).
-//! 4. `solve_step`: the exact constrained minimiser of the point-to-line cost for
-//!    the current correspondences (closed form + 1-D secular equation; no
-//!    linearisation).
-//! 5. `covariance`: Hessian-based covariance scaled by the residual variance, and
-//!    the conditioning flag.
-//! 6. [`Matcher`]: the loop, convergence, and the checks that turn a doubtful answer
-//!    into an [`IcpError`].
+//!    consecutive reference points (closest point by CSM's angular walk over the
+//!    ordered rays — the default — or a kiddo k-d tree; no segment across a range
+//!    discontinuity, none beyond the end of a run), measured against that segment's
+//!    local line, weighted by the inverse variance range noise gives the distance at
+//!    the two incidence angles.
+//! 3. `trimming`: adaptive outlier threshold (robust σ from the median, the size of
+//!    the previous step while far from convergence, optional fraction, never
+//!    increasing).
+//! 4. `solve_step`: the **exact** constrained minimiser of the weighted point-to-line
+//!    cost for the current correspondences, Censi's closed form (ICRA 2008): the cost
+//!    is quadratic in `(x, y, cos θ, sin θ)` under `cos²θ + sin²θ = 1`; after
+//!    eliminating the translation, the Lagrange multiplier is the root of a 1-D
+//!    secular equation (his quartic), solved to machine precision. No linearisation.
+//! 5. `covariance`: Hessian-based covariance `σ̂² I⁻¹` scaled by the residual
+//!    variance and by the residual autocorrelation along the scan (not Censi's 2007
+//!    closed form); the condition number and weakest direction.
+//! 6. [`Matcher`]: the loop. Convergence when a step is below the epsilons (and the
+//!    threshold no longer shrinks), or when the same correspondences come back (a
+//!    cycle). Along a direction the scans do not constrain (condition number above
+//!    `max_condition_number`, e.g. a corridor) steps are not taken: the result keeps
+//!    the first guess there and is flagged `ill_conditioned`. A result too far from
+//!    the first guess, NaN, or too few matches is an [`IcpError`].
 //!
 //! ```no_run
 //! use odocal_icp::{IcpParams, Matcher, PreparedScan};
