@@ -122,12 +122,13 @@ pub(crate) fn nearest_by_tree(
 ///
 /// Returns the segment index `i` (segment from point `i` to `i + 1`).
 pub(crate) fn segment_for(reference: &PreparedScan, p: [f64; 2], j: usize) -> Option<usize> {
-    let ray = &reference.rays[j];
-    let e = [p[0] - ray.point[0], p[1] - ray.point[1]];
+    let point = reference.rays[j].point;
+    let sides = &reference.sides[j];
+    let e = [(p[0] - point[0]) as f32, (p[1] - point[1]) as f32];
     // Distance of p's projection from point j along each usable segment (NaN when
     // that segment is not usable: NaN never compares true).
-    let forward = e[0] * ray.to_next[0] + e[1] * ray.to_next[1];
-    let backward = e[0] * ray.to_previous[0] + e[1] * ray.to_previous[1];
+    let forward = e[0] * sides.to_next[0] + e[1] * sides.to_next[1];
+    let backward = e[0] * sides.to_previous[0] + e[1] * sides.to_previous[1];
     if forward >= 0.0 && (backward.is_nan() || backward <= forward) {
         Some(j)
     } else if backward >= 0.0 {

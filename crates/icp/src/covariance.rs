@@ -178,7 +178,9 @@ impl InformationSum {
         let sigma2 = self.sum_sq / (m.saturating_sub(3).max(1)) as f64 * self.inflation();
         let rho = (self.sum_r2 / m.max(1) as f64).sqrt().max(1e-6);
         let d = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 1.0 / rho));
-        let scaled = d * self.info * d;
+        // Only the upper triangle was accumulated.
+        let info = Matrix3::from_fn(|r, c| self.info[(r.min(c), r.max(c))]);
+        let scaled = d * info * d;
         if !scaled.iter().all(|v| v.is_finite()) {
             return None;
         }

@@ -84,6 +84,8 @@ pub struct Matcher {
     squared_residuals: Vec<f64>,
     /// Per valid current point: the reference ray where the last search ended.
     search_start: Vec<u32>,
+    /// Per valid current point: the last segment matched and its weight.
+    weight_cache: Vec<(u32, f64)>,
 }
 
 impl Matcher {
@@ -94,6 +96,7 @@ impl Matcher {
             correspondences: Vec::new(),
             squared_residuals: Vec::new(),
             search_start: Vec::new(),
+            weight_cache: Vec::new(),
         }
     }
 
@@ -128,6 +131,9 @@ impl Matcher {
 
         // First guess of the reference ray for each current point: its bearing turned
         // by the guessed rotation (the walk then corrects for the translation).
+        self.weight_cache.clear();
+        self.weight_cache
+            .resize(current.valid_indices.len(), (u32::MAX, 0.0));
         self.search_start.clear();
         match (reference.uniform, current.uniform) {
             // Same ray geometry: the guess is a shift of the ray index.
@@ -360,7 +366,11 @@ impl Matcher {
                 continue;
             };
             let residual = line.normal[0] * p[0] + line.normal[1] * p[1] - line.offset;
-            let weight = if self.params.incidence_weighting {
+            let weight = if !self.params.incidence_weighting {
+                1.0
+            } else if self.weight_cache[k].0 == seg as u32 {
+                self.weight_cache[k].1
+            } else {
                 // Incidence of the current ray on its own surface (a property of the
                 // current scan alone, so that a correspondence's weight never depends
                 // on the estimate), or of the reference rays when unknown.
@@ -371,11 +381,14 @@ impl Matcher {
                     own
                 };
                 let floor = self.params.min_incidence_cos;
-                1.0 / (cos_cur * cos_cur
-                    + self.params.reference_noise_share * line.incidence_cos * line.incidence_cos
-                    + floor * floor)
-            } else {
-                1.0
+                let w = 1.0
+                    / (cos_cur * cos_cur
+                        + self.params.reference_noise_share
+                            * line.incidence_cos
+                            * line.incidence_cos
+                        + floor * floor);
+                self.weight_cache[k] = (seg as u32, w);
+                w
             };
             self.correspondences.push(Correspondence {
                 q,

@@ -35,12 +35,16 @@ pub(crate) struct Ray {
     pub dir: [f64; 2],
     /// The measured point in the sensor frame, NaN when invalid.
     pub point: [f64; 2],
-    /// Unit vector from this point to the next one when the segment between them is
-    /// usable, NaN otherwise.
-    pub to_next: [f64; 2],
-    /// Unit vector from this point to the previous one when that segment is usable,
-    /// NaN otherwise.
-    pub to_previous: [f64; 2],
+}
+
+/// Unit vectors from a point to its neighbours along usable segments (NaN where the
+/// segment is not usable), in `f32`: they only choose a side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Sides {
+    /// Towards the next point.
+    pub to_next: [f32; 2],
+    /// Towards the previous point.
+    pub to_previous: [f32; 2],
 }
 
 /// A scan preprocessed once, usable as reference or as current scan any number of times.
@@ -50,6 +54,8 @@ pub struct PreparedScan {
     pub(crate) angles: Vec<f64>,
     /// Ray directions and points.
     pub(crate) rays: Vec<Ray>,
+    /// Directions to the neighbours along usable segments.
+    pub(crate) sides: Vec<Sides>,
     /// Points in the sensor frame (NaN where invalid).
     pub(crate) points: Vec<[f64; 2]>,
     /// Validity of each reading.
@@ -161,21 +167,24 @@ impl PreparedScan {
             let (a, b) = (points[from], points[to]);
             let d = [b[0] - a[0], b[1] - a[1]];
             let inv = 1.0 / (d[0] * d[0] + d[1] * d[1]).sqrt();
-            [d[0] * inv, d[1] * inv]
+            [(d[0] * inv) as f32, (d[1] * inv) as f32]
         };
-        let rays = (0..n)
-            .map(|i| Ray {
-                dir: dirs[i],
-                point: points[i],
+        let sides = (0..n)
+            .map(|i| Sides {
                 to_next: match segments[i] {
                     Some(_) => unit_towards(i, i + 1),
-                    None => [f64::NAN; 2],
+                    None => [f32::NAN; 2],
                 },
                 to_previous: match i.checked_sub(1).and_then(|k| segments[k]) {
                     Some(_) => unit_towards(i, i - 1),
-                    None => [f64::NAN; 2],
+                    None => [f32::NAN; 2],
                 },
             })
+            .collect();
+        let rays = dirs
+            .iter()
+            .zip(&points)
+            .map(|(&dir, &point)| Ray { dir, point })
             .collect();
         let tree = if params.search == NeighbourSearch::KdTree || !angles_increasing {
             let pts: Vec<[f64; 2]> = valid_indices.iter().map(|&i| points[i as usize]).collect();
@@ -186,6 +195,7 @@ impl PreparedScan {
         Ok(PreparedScan {
             angles: angles.to_vec(),
             rays,
+            sides,
             points,
             valid,
             incidence_cos,
