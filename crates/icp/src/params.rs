@@ -34,7 +34,9 @@ pub struct IcpParams {
     /// A current point farther than this from every reference point gets no match (m).
     pub max_correspondence_dist: f64,
     /// At most this fraction of the matches (the ones with the smallest residuals) is
-    /// used; 1 disables the fractional trimming.
+    /// used; 1 (the default) disables the fractional trimming and leaves outlier
+    /// removal to the adaptive threshold alone: on simulated URG-04LX pairs, always
+    /// dropping the worst 5 % cost 5–10 % of accuracy.
     pub trim_fraction: f64,
     /// Adaptive threshold: residuals above `outlier_sigma_mult · σ̂` are dropped, σ̂ being
     /// the robust (median-based) spread of the residuals of the iteration.
@@ -65,7 +67,8 @@ pub struct IcpParams {
     /// A match with fewer used correspondences is rejected.
     pub min_correspondences: usize,
     /// Above this condition number of the (scale-normalised) information matrix the
-    /// result is flagged `ill_conditioned`.
+    /// result is flagged `ill_conditioned`, and the iterations take no step along the
+    /// least constrained direction (the result keeps the first guess there).
     pub max_condition_number: f64,
     /// Closest-point search method.
     pub search: NeighbourSearch,
