@@ -163,20 +163,29 @@ impl PreparedScan {
                 }
             })
             .collect();
-        let unit_towards = |from: usize, to: usize| {
-            let (a, b) = (points[from], points[to]);
-            let d = [b[0] - a[0], b[1] - a[1]];
-            let inv = 1.0 / (d[0] * d[0] + d[1] * d[1]).sqrt();
-            [(d[0] * inv) as f32, (d[1] * inv) as f32]
+        // The direction between consecutive points of a usable segment is, up to its
+        // sign, the tangent of the segment's local line.
+        let unit_towards = |line: &SegmentLine, from: usize, to: usize| {
+            let t = [-line.normal[1], line.normal[0]];
+            let d = [
+                points[to][0] - points[from][0],
+                points[to][1] - points[from][1],
+            ];
+            let sign = if t[0] * d[0] + t[1] * d[1] >= 0.0 {
+                1.0
+            } else {
+                -1.0
+            };
+            [(sign * t[0]) as f32, (sign * t[1]) as f32]
         };
         let sides = (0..n)
             .map(|i| Sides {
-                to_next: match segments[i] {
-                    Some(_) => unit_towards(i, i + 1),
+                to_next: match &segments[i] {
+                    Some(line) => unit_towards(line, i, i + 1),
                     None => [f32::NAN; 2],
                 },
-                to_previous: match i.checked_sub(1).and_then(|k| segments[k]) {
-                    Some(_) => unit_towards(i, i - 1),
+                to_previous: match i.checked_sub(1).and_then(|k| segments[k].as_ref()) {
+                    Some(line) => unit_towards(line, i, i - 1),
                     None => [f32::NAN; 2],
                 },
             })
