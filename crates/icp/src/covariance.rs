@@ -99,7 +99,7 @@ pub(crate) struct InformationSum {
     recent: [(i64, f64); MAX_LAG],
     /// Σ r_i r_{i−k} and the number of such pairs, per lag k (index k − 1).
     lag_sum: [f64; MAX_LAG],
-    lag_count: [usize; MAX_LAG],
+    lag_count: [f64; MAX_LAG],
 }
 
 /// Largest lag (rays) of the residual autocorrelation (a power of two).
@@ -119,7 +119,7 @@ impl InformationSum {
             count: 0,
             recent: [(i64::MIN, 0.0); MAX_LAG],
             lag_sum: [0.0; MAX_LAG],
-            lag_count: [0; MAX_LAG],
+            lag_count: [0.0; MAX_LAG],
         }
     }
 
@@ -130,12 +130,12 @@ impl InformationSum {
         let r = w.sqrt() * residual;
         let ray = ray as i64;
         // `recent` holds the residual of ray j at slot j mod MAX_LAG.
+        // Branch-free: a slot holding another ray adds nothing.
         for lag in 1..=MAX_LAG as i64 {
             let (previous, r_previous) = self.recent[((ray - lag) & LAG_MASK) as usize];
-            if previous == ray - lag {
-                self.lag_sum[lag as usize - 1] += r * r_previous;
-                self.lag_count[lag as usize - 1] += 1;
-            }
+            let present = f64::from(u8::from(previous == ray - lag));
+            self.lag_sum[lag as usize - 1] += present * r * r_previous;
+            self.lag_count[lag as usize - 1] += present;
         }
         self.recent[(ray & LAG_MASK) as usize] = (ray, r);
         let (s, c) = (self.sin, self.cos);
@@ -160,10 +160,10 @@ impl InformationSum {
         }
         let mut factor = 1.0;
         for k in 0..MAX_LAG {
-            if self.lag_count[k] < 10 {
+            if self.lag_count[k] < 10.0 {
                 break;
             }
-            let rho = self.lag_sum[k] / self.lag_count[k] as f64 / variance;
+            let rho = self.lag_sum[k] / self.lag_count[k] / variance;
             if rho.is_nan() || rho <= 0.0 {
                 break;
             }
