@@ -7,7 +7,8 @@
 //!   default stride (≈ 0.4 s apart, non-overlapping) for logs of 2k, 4k and 8k scans,
 //!   on every core — how time grows with the log's length.
 //!
-//! First guesses are the identity, as in the pipeline's first pass.
+//! First guesses are the identity (the pipeline's `--identity-guess` mode; by default it
+//! matches a few hundred pairs from the identity and predicts the rest by odometry).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use odocal_geom::Pose2;
