@@ -176,6 +176,10 @@ fn three_sigma_rule_holds_over_seeds() {
         "errors are {rms:.2}σ RMS: the covariance is too small"
     );
     assert!(
+        rms > 0.25,
+        "errors are only {rms:.2}σ RMS: the covariance is uselessly pessimistic"
+    );
+    assert!(
         (beyond3 as f64) <= 0.02 * checks as f64,
         "{beyond3} of {checks} estimates beyond 3σ"
     );
