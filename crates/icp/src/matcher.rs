@@ -164,6 +164,7 @@ impl Matcher {
         let mut last_step = (f64::INFINITY, f64::INFINITY);
         // Fingerprints of the sets of used correspondences of the last iterations.
         let mut history = [0u64; CYCLE_MEMORY];
+        let mut well_conditioned = false;
         // Set after a first cycle: the threshold then follows the residual spread only.
         let mut motion_term_dropped = false;
         while iterations < params.max_iterations {
@@ -215,12 +216,18 @@ impl Matcher {
             // Degeneracy: along a direction the scans hardly constrain (a corridor),
             // the step would only follow noise. Keep the estimate there as it is —
             // i.e. at the first guess — and move only along the others.
-            let (info, rho) = equations.information(estimate.theta);
-            if let Some(cond) = conditioning(&info, rho) {
-                if cond.condition_number.is_nan()
-                    || cond.condition_number > params.max_condition_number
-                {
-                    next = without_component(&estimate, &next, cond.weakest_direction, rho);
+            // The geometry changes little between iterations: once the problem is found
+            // comfortably well conditioned (10× margin), it is not checked again.
+            if !well_conditioned {
+                let (info, rho) = equations.information(estimate.theta);
+                if let Some(cond) = conditioning(&info, rho) {
+                    if cond.condition_number.is_nan()
+                        || cond.condition_number > params.max_condition_number
+                    {
+                        next = without_component(&estimate, &next, cond.weakest_direction, rho);
+                    } else if cond.condition_number * 10.0 < params.max_condition_number {
+                        well_conditioned = true;
+                    }
                 }
             }
             let step = estimate.between(&next);
