@@ -34,7 +34,7 @@ enum Command {
     /// Describe a log: counts per message, time span, scan geometry, encoder rate.
     Info(info::Args),
     /// Simulate a robot with encoders and a URG-04LX; write a log and its ground truth.
-    Simulate(simulate::Args),
+    Simulate(Box<simulate::Args>),
     /// Reproduce the ICRA 2008 Table I in simulation and compare with the published rows.
     TableI(table_i::Args),
 }
@@ -46,7 +46,7 @@ fn main() -> ExitCode {
         Command::Match(a) => matching::run(a),
         Command::Solve(a) => solve::run(a),
         Command::Info(a) => info::run(a),
-        Command::Simulate(a) => simulate::run(a),
+        Command::Simulate(a) => simulate::run(*a),
         Command::TableI(a) => table_i::run(a),
     };
     match result {

@@ -19,13 +19,15 @@ pub enum LogError {
         expected: String,
     },
     /// Reading or writing failed at the operating-system level.
-    #[error("{file}: {source}")]
+    ///
+    /// The OS error is part of the message (not a separate `source`), so that error
+    /// chains printed with `{:#}` do not repeat it.
+    #[error("{file}: {error}")]
     Io {
         /// The file (or stream name).
         file: String,
         /// The underlying error.
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// A reader option (usually from the command line) has an impossible value.
     #[error("invalid {option}: expected {expected}")]
@@ -103,7 +105,7 @@ impl LogError {
     pub fn io(file: impl Into<String>, source: std::io::Error) -> Self {
         LogError::Io {
             file: file.into(),
-            source,
+            error: source,
         }
     }
 
