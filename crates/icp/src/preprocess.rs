@@ -81,8 +81,16 @@ pub struct PreparedScan {
 /// Window statistics of a local line fit.
 #[derive(Clone, Copy)]
 struct WindowFit {
-    line: SegmentLine,
-    rms: f64,
+    /// Centroid, relative to `origin`.
+    mx: f64,
+    my: f64,
+    /// Centred scatter.
+    sxx: f64,
+    sxy: f64,
+    syy: f64,
+    /// Smallest eigenvalue of the scatter (sum of squared line residuals).
+    smallest: f64,
+    origin: [f64; 2],
 }
 
 impl PreparedScan {
@@ -367,23 +375,38 @@ fn local_lines(
             }
             fits.push(moments.fit(origin, w));
         }
+        // Residual sum of squares allowed for a window of w points.
+        let max_smallest = params.max_line_fit_rms * params.max_line_fit_rms * w as f64;
+        // Consecutive segments often pick the same window: its line is computed once.
+        let mut cached: Option<(usize, SegmentLine)> = None;
         for (i, segment) in segments.iter_mut().enumerate().take(end).skip(start) {
             // Windows s..s+w containing i and i+1: s in [i + 2 - w, i] within the run.
             let s_lo = (i + 2).saturating_sub(w).max(start);
             let s_hi = i.min(end + 1 - w);
-            let best = fits[s_lo - start..=s_hi - start]
-                .iter()
-                .min_by(|a, b| a.rms.total_cmp(&b.rms));
-            if let Some(best) = best {
-                if best.rms <= params.max_line_fit_rms && best.line.normal[0].is_finite() {
-                    let mut line = best.line;
-                    let n = line.normal;
-                    let cos =
-                        |k: usize| (n[0] * points[k][0] + n[1] * points[k][1]) * inv_ranges[k];
-                    line.incidence_cos = 0.5 * (cos(i) + cos(i + 1)).abs();
-                    *segment = Some(line);
-                }
+            let best = (s_lo..=s_hi).min_by(|&a, &b| {
+                fits[a - start]
+                    .smallest
+                    .total_cmp(&fits[b - start].smallest)
+            });
+            let Some(best) = best else { continue };
+            if fits[best - start].smallest > max_smallest {
+                continue;
             }
+            let mut line = match cached {
+                Some((s, line)) if s == best => line,
+                _ => {
+                    let line = fits[best - start].line();
+                    cached = Some((best, line));
+                    line
+                }
+            };
+            if !line.normal[0].is_finite() {
+                continue;
+            }
+            let n = line.normal;
+            let cos = |k: usize| (n[0] * points[k][0] + n[1] * points[k][1]) * inv_ranges[k];
+            line.incidence_cos = 0.5 * (cos(i) + cos(i + 1)).abs();
+            *segment = Some(line);
         }
         start = end + 1;
     }
@@ -412,63 +435,63 @@ impl Moments {
         self.yy += sign * dy * dy;
     }
 
-    /// The total-least-squares line of the `count` points summed.
+    /// Centroid, scatter and residual sum of squares of the `count` points summed
+    /// (the line itself is computed only for the windows that get used).
     fn fit(&self, origin: [f64; 2], count: usize) -> WindowFit {
         let k = count as f64;
         let (mx, my) = (self.x / k, self.y / k);
         let sxx = (self.xx - mx * self.x).max(0.0);
         let syy = (self.yy - my * self.y).max(0.0);
         let sxy = self.xy - mx * self.y;
-        line_from_scatter(origin, mx, my, sxx, sxy, syy, k)
+        let half_trace = 0.5 * (sxx + syy);
+        let half_gap = 0.5 * (sxx - syy);
+        let half_diff = (half_gap * half_gap + sxy * sxy).sqrt();
+        WindowFit {
+            mx,
+            my,
+            sxx,
+            sxy,
+            syy,
+            smallest: (half_trace - half_diff).max(0.0),
+            origin,
+        }
     }
 }
 
 /// Total-least-squares line through `pts` (at least 2 points) and its RMS residual.
 #[cfg(test)]
-fn fit_window(pts: &[[f64; 2]]) -> WindowFit {
+fn fit_window(pts: &[[f64; 2]]) -> (SegmentLine, f64) {
     let mut m = Moments::default();
     for p in pts {
         m.add(*p, pts[0], 1.0);
     }
-    m.fit(pts[0], pts.len())
+    let fit = m.fit(pts[0], pts.len());
+    (fit.line(), (fit.smallest / pts.len() as f64).sqrt())
 }
 
-/// The line through the centroid `origin + (mx, my)` along the major axis of the
-/// centred scatter `[[sxx, sxy], [sxy, syy]]` of `k` points.
-fn line_from_scatter(
-    o: [f64; 2],
-    mx: f64,
-    my: f64,
-    sxx: f64,
-    sxy: f64,
-    syy: f64,
-    k: f64,
-) -> WindowFit {
-    // Smallest eigenvalue of the scatter [[sxx, sxy], [sxy, syy]] and its eigenvector
-    // (the normal), from whichever of the two equivalent forms is better conditioned.
-    let half_trace = 0.5 * (sxx + syy);
-    let half_gap = 0.5 * (sxx - syy);
-    let half_diff = (half_gap * half_gap + sxy * sxy).sqrt();
-    let smallest = (half_trace - half_diff).max(0.0);
-    let u = [sxy, smallest - sxx];
-    let v = [smallest - syy, sxy];
-    let (nu, nv) = (u[0] * u[0] + u[1] * u[1], v[0] * v[0] + v[1] * v[1]);
-    let (w, nw) = if nu >= nv { (u, nu) } else { (v, nv) };
-    let inv = if nw > 0.0 { 1.0 / nw.sqrt() } else { f64::NAN };
-    let mut normal = [w[0] * inv, w[1] * inv];
-    let centroid = [o[0] + mx, o[1] + my];
-    let mut offset = normal[0] * centroid[0] + normal[1] * centroid[1];
-    if offset > 0.0 {
-        normal = [-normal[0], -normal[1]];
-        offset = -offset;
-    }
-    WindowFit {
-        line: SegmentLine {
+impl WindowFit {
+    /// The line through the centroid along the major axis of the scatter, its normal
+    /// pointing towards the sensor. The normal is the eigenvector of the smallest
+    /// eigenvalue, from whichever of two equivalent forms is better conditioned.
+    fn line(&self) -> SegmentLine {
+        let (sxx, sxy, syy, smallest) = (self.sxx, self.sxy, self.syy, self.smallest);
+        let u = [sxy, smallest - sxx];
+        let v = [smallest - syy, sxy];
+        let (nu, nv) = (u[0] * u[0] + u[1] * u[1], v[0] * v[0] + v[1] * v[1]);
+        let (w, nw) = if nu >= nv { (u, nu) } else { (v, nv) };
+        let inv = if nw > 0.0 { 1.0 / nw.sqrt() } else { f64::NAN };
+        let mut normal = [w[0] * inv, w[1] * inv];
+        let centroid = [self.origin[0] + self.mx, self.origin[1] + self.my];
+        let mut offset = normal[0] * centroid[0] + normal[1] * centroid[1];
+        if offset > 0.0 {
+            normal = [-normal[0], -normal[1]];
+            offset = -offset;
+        }
+        SegmentLine {
             normal,
             offset,
             incidence_cos: 1.0,
-        },
-        rms: (smallest / k).sqrt(),
+        }
     }
 }
 
@@ -488,12 +511,12 @@ mod tests {
                 [d * n[0] + u * t[0], d * n[1] + u * t[1]]
             })
             .collect();
-        let fit = fit_window(&pts);
-        assert!(fit.rms < 1e-12);
+        let (line, rms) = fit_window(&pts);
+        assert!(rms < 1e-12);
         // Normal towards the sensor: −n, offset −d.
-        assert!((fit.line.normal[0] + n[0]).abs() < 1e-12);
-        assert!((fit.line.normal[1] + n[1]).abs() < 1e-12);
-        assert!((fit.line.offset + d).abs() < 1e-12);
+        assert!((line.normal[0] + n[0]).abs() < 1e-12);
+        assert!((line.normal[1] + n[1]).abs() < 1e-12);
+        assert!((line.offset + d).abs() < 1e-12);
     }
 
     #[test]
