@@ -66,11 +66,19 @@ struct Correspondence {
     offset: f64,
     /// Weight (inverse residual variance up to a common factor).
     weight: f64,
+    /// Tilt variance of the line per unit range-noise variance, and the position of
+    /// its window's centroid along the line (errors-in-variables correction).
+    tilt_variance: f64,
+    centroid_along: f64,
     /// `residual² · weight`: what the trimming compares (squared).
     normalized_sq: f64,
     /// Index of the current point and of the reference segment (for cycle detection).
     key: u64,
 }
+
+/// Lines whose tilt variance exceeds this (rad², i.e. a tilt σ of ≈ 1.8°) get no
+/// errors-in-variables correction (the first-order correction would not hold).
+const MAX_CORRECTED_TILT_VARIANCE: f64 = 0.02;
 
 /// Number of past correspondence sets remembered to detect a cycle.
 const CYCLE_MEMORY: usize = 8;
@@ -188,6 +196,9 @@ impl Matcher {
             };
             let motion_limited;
             (tau, motion_limited) = threshold(&mut self.squared_residuals, &params, motion, tau);
+            // Tilt-noise scale of the reference lines, for the errors-in-variables
+            // correction (0 on noise-free scans).
+            let noise_variance = reference.tilt_noise_scale;
             let tau_sq = tau * tau;
 
             let mut equations = NormalEquations::new();
@@ -199,6 +210,18 @@ impl Matcher {
                 .filter(|c| c.normalized_sq <= tau_sq)
             {
                 equations.add(c.q, c.normal, c.offset, c.weight);
+                if noise_variance > 0.0 {
+                    // First-order correction: only for lines whose tilt is small.
+                    let tilt = noise_variance * c.tilt_variance;
+                    if tilt <= MAX_CORRECTED_TILT_VARIANCE {
+                        equations.remove_tilt_noise(
+                            c.q,
+                            c.normal,
+                            c.centroid_along,
+                            c.weight * tilt,
+                        );
+                    }
+                }
                 used += 1;
                 fingerprint = (fingerprint ^ c.key).wrapping_mul(0x0000_0100_0000_01b3);
             }
@@ -402,6 +425,8 @@ impl Matcher {
                 normal: line.normal,
                 offset: line.offset,
                 weight,
+                tilt_variance: line.tilt_variance,
+                centroid_along: line.centroid_along,
                 normalized_sq: residual * residual * weight,
                 key: ((k as u64) << 32) | seg as u64,
             });
