@@ -209,18 +209,20 @@ impl Matcher {
                 .iter()
                 .filter(|c| c.normalized_sq <= tau_sq)
             {
-                equations.add(c.q, c.normal, c.offset, c.weight);
-                if noise_variance > 0.0 {
-                    // First-order correction: only for lines whose tilt is small.
-                    let tilt = noise_variance * c.tilt_variance;
-                    if tilt <= MAX_CORRECTED_TILT_VARIANCE {
-                        equations.remove_tilt_noise(
-                            c.q,
-                            c.normal,
-                            c.centroid_along,
-                            c.weight * tilt,
-                        );
-                    }
+                // Errors-in-variables correction, first order: only for lines whose
+                // tilt is small.
+                let tilt = noise_variance * c.tilt_variance;
+                if tilt > 0.0 && tilt <= MAX_CORRECTED_TILT_VARIANCE {
+                    equations.add_corrected(
+                        c.q,
+                        c.normal,
+                        c.offset,
+                        c.weight,
+                        c.centroid_along,
+                        c.weight * tilt,
+                    );
+                } else {
+                    equations.add(c.q, c.normal, c.offset, c.weight);
                 }
                 used += 1;
                 fingerprint = (fingerprint ^ c.key).wrapping_mul(0x0000_0100_0000_01b3);

@@ -56,46 +56,43 @@ impl NormalEquations {
         }
     }
 
-    /// Removes the expected effect of the noise of a reference line's tilt from the
-    /// sums (errors-in-variables correction): a tilt `δφ` of the line moves the
-    /// correspondence's row by `δφ·b`, `b = [t_x, t_y, t·q, t×q]` with the tangent
-    /// `t = (−n_y, n_x)`, and its offset by `δφ·(t·m)`, `m` the window centroid.
-    /// Left in, `E[δφ²] b bᵀ` attenuates the estimated rotation (by ≈ 1e-4·θ on
-    /// the URG-04LX model) and couples some translation to it.
+    /// [`NormalEquations::add`] with the expected effect of the noise of the
+    /// reference line's tilt removed (errors-in-variables correction): a tilt `δφ` of
+    /// the line moves the correspondence's row by `δφ·b`, `b = [t_x, t_y, t·q, t×q]`
+    /// with the tangent `t = (−n_y, n_x)`, and its offset by `δφ·(t·m)`, `m` the
+    /// window centroid. Left in, `E[δφ²]·b bᵀ` attenuates the estimated rotation (by
+    /// ≈ 1e-4·θ on the URG-04LX model) and couples some translation to it.
+    /// `w_tilt_variance` is `w·E[δφ²]`.
     #[inline]
-    pub fn remove_tilt_noise(
+    pub fn add_corrected(
         &mut self,
         q: [f64; 2],
         normal: [f64; 2],
+        offset: f64,
+        w: f64,
         centroid_along: f64,
         w_tilt_variance: f64,
     ) {
-        let t = [-normal[1], normal[0]];
-        let b = [
-            t[0],
-            t[1],
-            t[0] * q[0] + t[1] * q[1],
-            t[1] * q[0] - t[0] * q[1],
-        ];
-        let vb = [
-            w_tilt_variance * b[0],
-            w_tilt_variance * b[1],
-            w_tilt_variance * b[2],
-            w_tilt_variance * b[3],
-        ];
+        let [nx, ny] = normal;
+        let a = [nx, ny, nx * q[0] + ny * q[1], ny * q[0] - nx * q[1]];
+        // Tangent t = (−ny, nx): t·q = −a₃ and t×q (= t_y q_x − t_x q_y) = a₂.
+        let b = [-ny, nx, -a[3], a[2]];
+        let wa = [w * a[0], w * a[1], w * a[2], w * a[3]];
+        let v = w_tilt_variance;
+        let vb = [v * b[0], v * b[1], v * b[2], v * b[3]];
         let h = &mut self.h;
-        h[0][0] -= vb[0] * b[0];
-        h[0][1] -= vb[0] * b[1];
-        h[0][2] -= vb[0] * b[2];
-        h[0][3] -= vb[0] * b[3];
-        h[1][1] -= vb[1] * b[1];
-        h[1][2] -= vb[1] * b[2];
-        h[1][3] -= vb[1] * b[3];
-        h[2][2] -= vb[2] * b[2];
-        h[2][3] -= vb[2] * b[3];
-        h[3][3] -= vb[3] * b[3];
-        for (g, vb) in self.g.iter_mut().zip(vb) {
-            *g -= vb * centroid_along;
+        h[0][0] += wa[0] * a[0] - vb[0] * b[0];
+        h[0][1] += wa[0] * a[1] - vb[0] * b[1];
+        h[0][2] += wa[0] * a[2] - vb[0] * b[2];
+        h[0][3] += wa[0] * a[3] - vb[0] * b[3];
+        h[1][1] += wa[1] * a[1] - vb[1] * b[1];
+        h[1][2] += wa[1] * a[2] - vb[1] * b[2];
+        h[1][3] += wa[1] * a[3] - vb[1] * b[3];
+        h[2][2] += wa[2] * a[2] - vb[2] * b[2];
+        h[2][3] += wa[2] * a[3] - vb[2] * b[3];
+        h[3][3] += wa[3] * a[3] - vb[3] * b[3];
+        for r in 0..4 {
+            self.g[r] += wa[r] * offset - vb[r] * centroid_along;
         }
     }
 
