@@ -73,10 +73,7 @@ impl Pose2 {
     /// Maps a point given in this frame into the parent frame.
     pub fn transform_point(&self, p: [f64; 2]) -> [f64; 2] {
         let (s, c) = self.theta.sin_cos();
-        [
-            self.x + c * p[0] - s * p[1],
-            self.y + s * p[0] + c * p[1],
-        ]
+        [self.x + c * p[0] - s * p[1], self.y + s * p[0] + c * p[1]]
     }
 
     /// Length of the translation part (m).
