@@ -151,6 +151,22 @@ pub fn thread_pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> 
         .context("cannot start the scan-matching threads")
 }
 
+/// Reads the log named on the command line, strict unless `lenient`, with an optional
+/// `--ticks-per-rev` override (shared by `calibrate` and `match`).
+pub fn read_input_log(
+    path: &std::path::Path,
+    lenient: bool,
+    ticks_per_rev: Option<f64>,
+) -> anyhow::Result<odocal_log::Log> {
+    let opts = ReadOptions {
+        mode: if lenient { Mode::Lenient } else { Mode::Strict },
+        ticks_per_revolution: ticks_per_rev,
+        ..ReadOptions::default()
+    };
+    // The reader's message already says everything (file, line, cause).
+    read_log(path, &opts).map_err(|e| anyhow::anyhow!("{e}"))
+}
+
 /// Parameters from `--nominal`: three values (r_L, r_R, b; laser at the origin) or six.
 fn nominal_params(v: &[f64]) -> anyhow::Result<Params> {
     let full = match v.len() {
@@ -170,20 +186,7 @@ fn nominal_params(v: &[f64]) -> anyhow::Result<Params> {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let pool = thread_pool(args.threads)?;
     let t_parse = Instant::now();
-    let log = read_log(
-        &args.log,
-        &ReadOptions {
-            mode: if args.lenient {
-                Mode::Lenient
-            } else {
-                Mode::Strict
-            },
-            ticks_per_revolution: args.ticks_per_rev,
-            ..ReadOptions::default()
-        },
-    )
-    // The reader's message already says everything (file, line, cause).
-    .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let log = read_input_log(&args.log, args.lenient, args.ticks_per_rev)?;
     let parse_s = t_parse.elapsed().as_secs_f64();
 
     let initial_params = args.nominal.as_deref().map(nominal_params).transpose()?;

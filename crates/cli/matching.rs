@@ -1,9 +1,8 @@
 //! `odocal match LOG --out FILE`: synchronization and scan matching only; writes the
 //! samples as tuples (one JSON object per line).
 
-use crate::calibrate::{thread_pool, Bar};
+use crate::calibrate::{read_input_log, thread_pool, Bar};
 use anyhow::Context;
-use odocal_log::{read_log, Mode, ReadOptions};
 use odocal_pipeline::{synchronize_and_match, write_tuples, Options, Timing};
 use std::path::PathBuf;
 
@@ -40,20 +39,7 @@ pub struct Args {
 /// Runs `odocal match`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let pool = thread_pool(args.threads)?;
-    let log = read_log(
-        &args.log,
-        &ReadOptions {
-            mode: if args.lenient {
-                Mode::Lenient
-            } else {
-                Mode::Strict
-            },
-            ticks_per_revolution: args.ticks_per_rev,
-            ..ReadOptions::default()
-        },
-    )
-    // The reader's message already says everything (file, line, cause).
-    .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let log = read_input_log(&args.log, args.lenient, args.ticks_per_rev)?;
     let opts = Options {
         ticks_per_revolution: args.ticks_per_rev,
         stride: args.stride,

@@ -56,7 +56,7 @@ pub use kinematics::{arc_motion, RobotParams};
 pub use laser::LaserConfig;
 pub use output::LogSummary;
 pub use planner::{MotionLimits, Planner, TrajectoryKind, TRAJECTORY_NAMES};
-pub use presets::{PresetRegistry, TableParams, TableRow, BUILTIN_PRESETS};
+pub use presets::{PresetRegistry, TableRow, BUILTIN_PRESETS};
 pub use simulation::{simulate, simulate_in, SimEncoderRecord, SimRun, SimScan};
 pub use truth::{GroundTruth, TruthFaults, TruthParams, TruthScan, TruthSlip, TRUTH_FORMAT};
 pub use world::{Segment, World};

@@ -12,6 +12,7 @@ use crate::config::SimConfig;
 use crate::error::SimError;
 use crate::laser::LaserConfig;
 use crate::planner::TrajectoryKind;
+use crate::truth::TruthParams;
 use odocal_geom::Pose2;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -35,24 +36,7 @@ pub struct TableRow {
     /// Number of samples of the experiment.
     pub samples: u64,
     /// The calibrated parameters in SI units.
-    pub si: TableParams,
-}
-
-/// The six parameters of a Table I row, in metres and radians.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-pub struct TableParams {
-    /// Left wheel radius (m).
-    pub r_l: f64,
-    /// Right wheel radius (m).
-    pub r_r: f64,
-    /// Wheel distance (m).
-    pub b: f64,
-    /// Laser x in the robot frame (m).
-    pub l_x: f64,
-    /// Laser y in the robot frame (m).
-    pub l_y: f64,
-    /// Laser heading in the robot frame (rad).
-    pub l_theta: f64,
+    pub si: TruthParams,
 }
 
 /// The presets available to [`SimConfig::preset`] and the command line.

@@ -9,7 +9,8 @@ use serde::{Deserialize, Serialize};
 /// Identifies the format of the truth JSON.
 pub const TRUTH_FORMAT: &str = "odocal-sim-truth/1";
 
-/// The six parameters, flat, in metres and radians.
+/// The six parameters, flat, in metres and radians (the truth file's `params`, and a
+/// Table I row's `si`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TruthParams {
     /// Left wheel radius (m).
