@@ -91,7 +91,8 @@ fn extreme_indices(eig: &SymmetricEigen<f64, nalgebra::U3>) -> (usize, usize) {
 pub(crate) struct InformationSum {
     sin: f64,
     cos: f64,
-    info: Matrix3<f64>,
+    /// Upper triangle of `Σ w JᵀJ`: (0,0), (0,1), (0,2), (1,1), (1,2), (2,2).
+    info: [f64; 6],
     sum_sq: f64,
     sum_r2: f64,
     count: usize,
@@ -113,7 +114,7 @@ impl InformationSum {
         InformationSum {
             sin,
             cos,
-            info: Matrix3::zeros(),
+            info: [0.0; 6],
             sum_sq: 0.0,
             sum_r2: 0.0,
             count: 0,
@@ -140,8 +141,15 @@ impl InformationSum {
         self.recent[(ray & LAG_MASK) as usize] = (ray, r);
         let (s, c) = (self.sin, self.cos);
         let dq = [-s * q[0] - c * q[1], c * q[0] - s * q[1]];
-        let j = nalgebra::Vector3::new(normal[0], normal[1], normal[0] * dq[0] + normal[1] * dq[1]);
-        self.info += (w * j) * j.transpose();
+        let j = [normal[0], normal[1], normal[0] * dq[0] + normal[1] * dq[1]];
+        let wj = [w * j[0], w * j[1], w * j[2]];
+        let info = &mut self.info;
+        info[0] += wj[0] * j[0];
+        info[1] += wj[0] * j[1];
+        info[2] += wj[0] * j[2];
+        info[3] += wj[1] * j[1];
+        info[4] += wj[1] * j[2];
+        info[5] += wj[2] * j[2];
         self.sum_sq += w * residual * residual;
         self.sum_r2 += q[0] * q[0] + q[1] * q[1];
         self.count += 1;
@@ -179,7 +187,8 @@ impl InformationSum {
         let rho = (self.sum_r2 / m.max(1) as f64).sqrt().max(1e-6);
         let d = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 1.0 / rho));
         // Only the upper triangle was accumulated.
-        let info = Matrix3::from_fn(|r, c| self.info[(r.min(c), r.max(c))]);
+        let t = &self.info;
+        let info = Matrix3::new(t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5]);
         let scaled = d * info * d;
         if !scaled.iter().all(|v| v.is_finite()) {
             return None;

@@ -21,16 +21,17 @@ const MAD_TO_SIGMA: f64 = 1.482_602_218_505_602;
 /// The threshold for this iteration, given the *squared* (normalised) residuals;
 /// `squared_residuals` is used as scratch (reordered). Returns τ (not squared) and
 /// whether the motion term raised it above what the residual spread alone gives (then
-/// the next iteration, with a smaller motion, will use a smaller τ).
+/// the next iteration, with a smaller motion, will use a smaller τ), and that smaller
+/// τ (the threshold without the motion term).
 pub(crate) fn threshold(
     squared_residuals: &mut [f64],
     params: &IcpParams,
     previous_motion: Option<f64>,
     previous_threshold: f64,
-) -> (f64, bool) {
+) -> (f64, bool, f64) {
     let m = squared_residuals.len();
     if m == 0 {
-        return (0.0, false);
+        return (0.0, false, 0.0);
     }
     // Median of the squared residuals; above 256 matches (and when no fractional
     // trimming needs the whole slice afterwards), of every k-th one only, gathered at
@@ -56,13 +57,15 @@ pub(crate) fn threshold(
     let noise_term = params.outlier_sigma_mult * sigma;
     let motion_limited = step_term > noise_term && noise_term < previous_threshold;
     let mut tau = noise_term.max(step_term).min(previous_threshold);
+    let mut noise_tau = noise_term.min(previous_threshold);
     if params.trim_fraction < 1.0 {
         // Keep the ⌈q·m⌉ smallest residuals at most.
         let keep = ((params.trim_fraction * m as f64).ceil() as usize).clamp(1, m);
         let (_, q, _) = squared_residuals.select_nth_unstable_by(keep - 1, f64::total_cmp);
         tau = tau.min(q.sqrt());
+        noise_tau = noise_tau.min(q.sqrt());
     }
-    (tau, motion_limited)
+    (tau, motion_limited, noise_tau)
 }
 
 #[cfg(test)]
@@ -80,7 +83,7 @@ mod tests {
             .map(|i| (0.001 * ((i % 9) as f64 / 4.0)).powi(2))
             .collect();
         r.extend(std::iter::repeat_n(0.05f64.powi(2), 10));
-        let (tau, _) = threshold(&mut r.clone(), &params, Some(1e-6), f64::INFINITY);
+        let (tau, _, _) = threshold(&mut r.clone(), &params, Some(1e-6), f64::INFINITY);
         assert!(tau > 0.002 && tau < 0.05, "tau = {tau}");
     }
 
@@ -92,10 +95,10 @@ mod tests {
         };
         let r: Vec<f64> = (1..=100).map(|i| (i as f64 * 1e-3).powi(2)).collect();
         // A large motion would allow everything; the fraction keeps 90 of 100.
-        let (tau, _) = threshold(&mut r.clone(), &params, Some(1.0), f64::INFINITY);
+        let (tau, _, _) = threshold(&mut r.clone(), &params, Some(1.0), f64::INFINITY);
         assert!((tau - 0.090).abs() < 1e-15);
         // Never above the previous threshold.
-        let (tau, _) = threshold(&mut r.clone(), &params, Some(1.0), 0.01);
+        let (tau, _, _) = threshold(&mut r.clone(), &params, Some(1.0), 0.01);
         assert_eq!(tau, 0.01);
     }
 }
