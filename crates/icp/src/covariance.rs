@@ -86,9 +86,18 @@ fn extreme_indices(eig: &SymmetricEigen<f64, nalgebra::U3>) -> (usize, usize) {
     (imin, imax)
 }
 
+/// Per-ray scratch of [`InformationSum`]: the weighted residual of each ray of the
+/// current scan (0 where none) and whether it has one (1 or 0), kept by the matcher so
+/// that a match allocates nothing.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct RayResiduals {
+    residual: Vec<f64>,
+    present: Vec<f64>,
+}
+
 /// Accumulates `I = Σ JᵀJ` and the residual sum of squares at a pose.
-#[derive(Debug, Clone)]
-pub(crate) struct InformationSum {
+#[derive(Debug)]
+pub(crate) struct InformationSum<'a> {
     sin: f64,
     cos: f64,
     /// Upper triangle of `Σ w JᵀJ`: (0,0), (0,1), (0,2), (1,1), (1,2), (2,2).
@@ -96,21 +105,20 @@ pub(crate) struct InformationSum {
     sum_sq: f64,
     sum_r2: f64,
     count: usize,
-    /// The last few (ray index, weighted residual), for the autocorrelation.
-    recent: [(i64, f64); MAX_LAG],
-    /// Σ r_i r_{i−k} and the number of such pairs, per lag k (index k − 1).
-    lag_sum: [f64; MAX_LAG],
-    lag_count: [f64; MAX_LAG],
+    rays: &'a mut RayResiduals,
 }
 
-/// Largest lag (rays) of the residual autocorrelation (a power of two).
+/// Largest lag (rays) of the residual autocorrelation.
 const MAX_LAG: usize = 8;
-const LAG_MASK: i64 = MAX_LAG as i64 - 1;
 
-impl InformationSum {
-    /// Empty sums at `pose`.
-    pub fn new(pose: &Pose2) -> Self {
+impl<'a> InformationSum<'a> {
+    /// Empty sums at `pose`, for a current scan of `ray_count` rays.
+    pub fn new(pose: &Pose2, ray_count: usize, rays: &'a mut RayResiduals) -> Self {
         let (sin, cos) = pose.theta.sin_cos();
+        rays.residual.clear();
+        rays.residual.resize(ray_count, 0.0);
+        rays.present.clear();
+        rays.present.resize(ray_count, 0.0);
         InformationSum {
             sin,
             cos,
@@ -118,27 +126,21 @@ impl InformationSum {
             sum_sq: 0.0,
             sum_r2: 0.0,
             count: 0,
-            recent: [(i64::MIN, 0.0); MAX_LAG],
-            lag_sum: [0.0; MAX_LAG],
-            lag_count: [0.0; MAX_LAG],
+            rays,
         }
     }
 
-    /// Adds a used correspondence: current point `q` (ray `ray`, added in increasing
-    /// ray order), reference line normal, residual and weight (inverse residual
-    /// variance up to the common factor σ̂²).
+    /// Adds a used correspondence: current point `q` of ray `ray` (each ray at most
+    /// once), reference line normal, residual and weight (inverse residual variance up
+    /// to the common factor σ̂²).
     pub fn add(&mut self, ray: usize, q: [f64; 2], normal: [f64; 2], residual: f64, w: f64) {
-        let r = w.sqrt() * residual;
-        let ray = ray as i64;
-        // `recent` holds the residual of ray j at slot j mod MAX_LAG.
-        // Branch-free: a slot holding another ray adds nothing.
-        for lag in 1..=MAX_LAG as i64 {
-            let (previous, r_previous) = self.recent[((ray - lag) & LAG_MASK) as usize];
-            let present = f64::from(u8::from(previous == ray - lag));
-            self.lag_sum[lag as usize - 1] += present * r * r_previous;
-            self.lag_count[lag as usize - 1] += present;
+        if let (Some(r), Some(p)) = (
+            self.rays.residual.get_mut(ray),
+            self.rays.present.get_mut(ray),
+        ) {
+            *r = w.sqrt() * residual;
+            *p = 1.0;
         }
-        self.recent[(ray & LAG_MASK) as usize] = (ray, r);
         let (s, c) = (self.sin, self.cos);
         let dq = [-s * q[0] - c * q[1], c * q[0] - s * q[1]];
         let j = [normal[0], normal[1], normal[0] * dq[0] + normal[1] * dq[1]];
@@ -160,18 +162,23 @@ impl InformationSum {
         self.count
     }
 
-    /// Variance inflation factor `1 + 2 Σ ρ_k` over the initial positive lags.
+    /// Variance inflation factor `1 + 2 Σ ρ_k` over the initial positive lags, `ρ_k`
+    /// the autocorrelation of the weighted residuals of rays `k` apart.
     pub fn inflation(&self) -> f64 {
         let variance = self.sum_sq / self.count.max(1) as f64;
         if variance.is_nan() || variance <= 0.0 {
             return 1.0;
         }
+        let (r, present) = (&self.rays.residual, &self.rays.present);
         let mut factor = 1.0;
-        for k in 0..MAX_LAG {
-            if self.lag_count[k] < 10.0 {
+        for lag in 1..=MAX_LAG.min(r.len()) {
+            // Missing residuals are 0 with presence 0: they add nothing to either sum.
+            let sum: f64 = r[lag..].iter().zip(r).map(|(a, b)| a * b).sum();
+            let pairs: f64 = present[lag..].iter().zip(present).map(|(a, b)| a * b).sum();
+            if pairs < 10.0 {
                 break;
             }
-            let rho = self.lag_sum[k] / self.lag_count[k] / variance;
+            let rho = sum / pairs / variance;
             if rho.is_nan() || rho <= 0.0 {
                 break;
             }
@@ -183,7 +190,8 @@ impl InformationSum {
     /// Covariance and conditioning; `None` when the sums are not finite.
     pub fn finish(&self) -> Option<Uncertainty> {
         let m = self.count;
-        let sigma2 = self.sum_sq / (m.saturating_sub(3).max(1)) as f64 * self.inflation();
+        let inflation = self.inflation();
+        let sigma2 = self.sum_sq / (m.saturating_sub(3).max(1)) as f64 * inflation;
         let rho = (self.sum_r2 / m.max(1) as f64).sqrt().max(1e-6);
         let d = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 1.0 / rho));
         // Only the upper triangle was accumulated.
@@ -232,7 +240,7 @@ impl InformationSum {
             condition_number,
             weakest_direction,
             residual_sigma: (self.sum_sq / (m.saturating_sub(3).max(1)) as f64).sqrt(),
-            inflation: self.inflation(),
+            inflation,
         })
     }
 }

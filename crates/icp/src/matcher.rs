@@ -1,7 +1,7 @@
 //! The ICP loop: correspondences, trimming, exact step, until the estimate settles.
 
 use crate::correspondence::{nearest_by_angle, nearest_by_tree, segment_for};
-use crate::covariance::{conditioning, InformationSum};
+use crate::covariance::{conditioning, InformationSum, RayResiduals};
 use crate::solve_step::NormalEquations;
 use crate::trimming::threshold;
 use crate::{IcpError, IcpParams, NeighbourSearch, PreparedScan};
@@ -101,6 +101,8 @@ pub struct Matcher {
     search_start: Vec<u32>,
     /// Per valid current point: the last segment matched and its weight.
     weight_cache: Vec<(u32, f64)>,
+    /// Scratch of the covariance's residual autocorrelation.
+    ray_residuals: RayResiduals,
 }
 
 impl Matcher {
@@ -112,6 +114,7 @@ impl Matcher {
             squared_residuals: Vec::new(),
             search_start: Vec::new(),
             weight_cache: Vec::new(),
+            ray_residuals: RayResiduals::default(),
         }
     }
 
@@ -359,7 +362,7 @@ impl Matcher {
 
         // Uncertainty at the final estimate, over the correspondences used last.
         let tau_sq = tau * tau;
-        let mut info = InformationSum::new(&estimate);
+        let mut info = InformationSum::new(&estimate, current.len(), &mut self.ray_residuals);
         let (s, c) = estimate.theta.sin_cos();
         let mut sum_abs = 0.0;
         for k in self
