@@ -373,8 +373,7 @@ pub(crate) fn step2_not_excited(
     let refs: Vec<&str> = parameters.iter().map(|s| s.as_str()).collect();
     SolveError::NotExcited {
         sentence: format!(
-            "{} not excited ({}): {}",
-            join_names(&refs),
+            "the motion does not excite them ({}); {}",
             motion.describe(),
             advice(&refs, &motion)
         ),
@@ -395,8 +394,7 @@ pub(crate) fn information_not_excited(
     let refs: Vec<&str> = parameters.iter().map(|s| s.as_str()).collect();
     SolveError::NotExcited {
         sentence: format!(
-            "{} not excited ({}): {}",
-            join_names(&refs),
+            "the motion does not excite them ({}); {}",
             motion.describe(),
             advice(&refs, motion)
         ),
