@@ -100,9 +100,34 @@ const ISSUE_TARGETS: Bounds = Bounds {
     p99_theta_deg: 0.07,
 };
 
-fn check(noise: &str, preset: &str, correlation_rays: Option<usize>, bounds: &Bounds) {
+/// Asserts `bounds` on the pairs of 40 s of the preset's driving (see [`misses`]).
+fn check(
+    noise: &str,
+    preset: &str,
+    correlation_rays: Option<usize>,
+    seed: Option<u64>,
+    bounds: &Bounds,
+) {
+    let failed = misses(noise, preset, correlation_rays, seed, bounds);
+    assert!(failed.is_empty(), "{noise} {preset}: {failed:?}");
+}
+
+/// The `bounds` missed on the pairs of 40 s of the preset's driving (panics when a
+/// match fails or too many are ill-conditioned); `seed` replaces the preset's
+/// simulation seed (trajectory and noise) when given.
+fn misses(
+    noise: &str,
+    preset: &str,
+    correlation_rays: Option<usize>,
+    seed: Option<u64>,
+    bounds: &Bounds,
+) -> Vec<String> {
     let mut config = PresetRegistry::builtin().get(preset).expect("preset");
     config.duration = 40.0;
+    if let Some(seed) = seed {
+        config.seed = seed;
+    }
+    let seed = config.seed;
     if let Some(rays) = correlation_rays {
         config.laser.correlation_rays = rays;
     }
@@ -115,7 +140,7 @@ fn check(noise: &str, preset: &str, correlation_rays: Option<usize>, bounds: &Bo
         let (rx, ry, rt) = (rms(&s.ex), rms(&s.ey), rms(&s.et).to_degrees());
         let (px, py, pt) = (p99(&s.ex), p99(&s.ey), p99(&s.et).to_degrees());
         println!(
-            "{noise:10} {preset:7} {label}: {n} pairs ({} ill-conditioned, {} failed) | RMS x {:.3} mm y {:.3} mm θ {:.4}° | p99 x {:.3} mm y {:.3} mm θ {:.4}°",
+            "{noise:10} {preset:7} seed {seed} {label}: {n} pairs ({} ill-conditioned, {} failed) | RMS x {:.3} mm y {:.3} mm θ {:.4}° | p99 x {:.3} mm y {:.3} mm θ {:.4}°",
             o.ill_conditioned, o.failures, rx * 1e3, ry * 1e3, rt, px * 1e3, py * 1e3, pt
         );
         assert_eq!(o.failures, 0, "{preset} {label}: matches failed");
@@ -136,7 +161,10 @@ fn check(noise: &str, preset: &str, correlation_rays: Option<usize>, bounds: &Bo
             }
         }
     }
-    assert!(failed.is_empty(), "{noise} {preset}: {failed:?}");
+    failed
+        .into_iter()
+        .map(|f| format!("{preset} seed {seed} {f}"))
+        .collect()
 }
 
 /// Issue 3's targets plus 15 %: a regression guard for the default (correlated-noise)
@@ -151,13 +179,13 @@ const TARGETS_PLUS_15_PERCENT: Bounds = Bounds {
 /// Independent range noise (σ 3 mm, 1 mm quantisation): issue 3's targets hold.
 #[test]
 fn arena_pairs_meet_the_targets_with_independent_noise() {
-    check("white", "khepera", Some(1), &ISSUE_TARGETS);
+    check("white", "khepera", Some(1), None, &ISSUE_TARGETS);
 }
 
 /// See [`arena_pairs_meet_the_targets_with_independent_noise`].
 #[test]
 fn office_pairs_meet_the_targets_with_independent_noise() {
-    check("white", "office", Some(1), &ISSUE_TARGETS);
+    check("white", "office", Some(1), None, &ISSUE_TARGETS);
 }
 
 /// The default sensor model: noise correlated over 4 rays, whose long-run average
@@ -169,24 +197,52 @@ fn office_pairs_meet_the_targets_with_independent_noise() {
 #[test]
 #[ignore = "issue 3 targets are at the noise floor of the correlated-noise sensor model; run with --ignored"]
 fn arena_pairs_meet_the_targets_with_correlated_noise() {
-    check("correlated", "khepera", None, &ISSUE_TARGETS);
+    check("correlated", "khepera", None, None, &ISSUE_TARGETS);
 }
 
 /// See [`arena_pairs_meet_the_targets_with_correlated_noise`].
 #[test]
 #[ignore = "issue 3 targets are at the noise floor of the correlated-noise sensor model; run with --ignored"]
 fn office_pairs_meet_the_targets_with_correlated_noise() {
-    check("correlated", "office", None, &ISSUE_TARGETS);
+    check("correlated", "office", None, None, &ISSUE_TARGETS);
 }
 
 /// Regression guard on the default sensor model (see [`TARGETS_PLUS_15_PERCENT`]).
 #[test]
 fn arena_pairs_within_15_percent_of_the_targets_with_correlated_noise() {
-    check("correlated", "khepera", None, &TARGETS_PLUS_15_PERCENT);
+    check(
+        "correlated",
+        "khepera",
+        None,
+        None,
+        &TARGETS_PLUS_15_PERCENT,
+    );
 }
 
 /// Regression guard on the default sensor model (see [`TARGETS_PLUS_15_PERCENT`]).
 #[test]
 fn office_pairs_within_15_percent_of_the_targets_with_correlated_noise() {
-    check("correlated", "office", None, &TARGETS_PLUS_15_PERCENT);
+    check("correlated", "office", None, None, &TARGETS_PLUS_15_PERCENT);
+}
+
+/// The targets on other simulations of the default sensor (other trajectories and
+/// noise draws): the errors vary from seed to seed by more than the margin to the
+/// targets (see docs/benchmarks.md), which is why the targets are not enforced on
+/// the default sensor model.
+#[test]
+#[ignore = "issue 3 targets are at the noise floor of the correlated-noise sensor model; run with --ignored"]
+fn other_seeds_meet_the_targets_with_correlated_noise() {
+    let mut failed = vec![];
+    for seed in [2, 3] {
+        for preset in ["khepera", "office"] {
+            failed.extend(misses(
+                "correlated",
+                preset,
+                None,
+                Some(seed),
+                &ISSUE_TARGETS,
+            ));
+        }
+    }
+    assert!(failed.is_empty(), "targets missed: {failed:?}");
 }
