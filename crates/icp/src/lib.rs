@@ -28,8 +28,10 @@
 //!    variance and by the residual autocorrelation along the scan (not Censi's 2007
 //!    closed form); the condition number and weakest direction.
 //! 6. [`Matcher`]: the loop. Convergence when a step is below the epsilons (and the
-//!    threshold no longer shrinks), or when the same correspondences come back (a
-//!    cycle). Along a direction the scans do not constrain (condition number above
+//!    threshold would drop no more matches), when the contraction of the last two
+//!    steps predicts a next step below the epsilons and negligible against the
+//!    residual noise (never on noise-free scans), or when the same correspondences
+//!    come back (a cycle). Along a direction the scans do not constrain (condition number above
 //!    `max_condition_number`, e.g. a corridor) steps are not taken: the result keeps
 //!    the first guess there and is flagged `ill_conditioned`. A result too far from
 //!    the first guess, NaN, or too few matches is an [`IcpError`].
