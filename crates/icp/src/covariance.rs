@@ -22,7 +22,7 @@
 //! RMS distance `ρ` of the used points (so all three axes are lengths):
 //! `condition_number = λ_max / λ_min` of `D I D`, `D = diag(1, 1, 1/ρ)`.
 
-use nalgebra::{Matrix3, SymmetricEigen};
+use nalgebra::{Matrix3, SymmetricEigen, U3};
 use odocal_geom::Pose2;
 
 /// Covariance and conditioning of a match.
@@ -51,8 +51,15 @@ pub(crate) fn conditioning(info: &[[f64; 3]; 3], rho: f64) -> Option<Conditionin
     } else {
         1.0
     };
+    let info = Matrix3::from_fn(|r, c| info[r][c]);
+    scaled_eigen(&info, rho).map(|(_, cond)| cond)
+}
+
+/// Eigen-decomposition of the scale-normalised information `D I D`,
+/// `D = diag(1, 1, 1/rho)`, and its conditioning; `None` when it is not finite.
+fn scaled_eigen(info: &Matrix3<f64>, rho: f64) -> Option<(SymmetricEigen<f64, U3>, Conditioning)> {
     let d = [1.0, 1.0, 1.0 / rho];
-    let scaled = Matrix3::from_fn(|r, c| d[r] * info[r][c] * d[c]);
+    let scaled = Matrix3::from_fn(|r, c| d[r] * info[(r, c)] * d[c]);
     if !scaled.iter().all(|v| v.is_finite()) {
         return None;
     }
@@ -66,14 +73,15 @@ pub(crate) fn conditioning(info: &[[f64; 3]; 3], rho: f64) -> Option<Conditionin
         f64::INFINITY
     };
     let v = eig.eigenvectors.column(imin);
-    Some(Conditioning {
+    let cond = Conditioning {
         condition_number,
         weakest_direction: [v[0], v[1], v[2]],
-    })
+    };
+    Some((eig, cond))
 }
 
 /// Indices of the smallest and largest eigenvalues.
-fn extreme_indices(eig: &SymmetricEigen<f64, nalgebra::U3>) -> (usize, usize) {
+fn extreme_indices(eig: &SymmetricEigen<f64, U3>) -> (usize, usize) {
     let (mut imin, mut imax) = (0, 0);
     for k in 1..3 {
         if eig.eigenvalues[k] < eig.eigenvalues[imin] {
@@ -223,25 +231,11 @@ impl<'a> InformationSum<'a> {
         let inflation = self.inflation();
         let sigma2 = self.sum_sq / (m.saturating_sub(3).max(1)) as f64 * inflation;
         let rho = (self.sum_r2 / m.max(1) as f64).sqrt().max(1e-6);
-        let d = Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, 1.0 / rho));
         // Only the upper triangle was accumulated.
         let t = &self.info;
         let info = Matrix3::new(t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5]);
-        let scaled = d * info * d;
-        if !scaled.iter().all(|v| v.is_finite()) {
-            return None;
-        }
-        let eig = SymmetricEigen::new(scaled);
-        let (imin, imax) = extreme_indices(&eig);
-        let lmin = eig.eigenvalues[imin].max(0.0);
-        let lmax = eig.eigenvalues[imax];
-        let condition_number = if lmin > 0.0 {
-            lmax / lmin
-        } else {
-            f64::INFINITY
-        };
-        let v = eig.eigenvectors.column(imin);
-        let weakest_direction = [v[0], v[1], v[2]];
+        let (eig, cond) = scaled_eigen(&info, rho)?;
+        let d = [1.0, 1.0, 1.0 / rho];
         // Covariance: σ̂² I⁻¹ = σ̂² D (DID)⁻¹ D, inverted in the eigenbasis so that a
         // singular direction gives an infinite (not NaN) variance along it.
         let mut cov = Matrix3::<f64>::zeros();
@@ -262,13 +256,13 @@ impl<'a> InformationSum<'a> {
         let mut covariance = [[0.0; 3]; 3];
         for (r, row) in covariance.iter_mut().enumerate() {
             for (c, v) in row.iter_mut().enumerate() {
-                *v = d[(r, r)] * cov[(r, c)] * d[(c, c)];
+                *v = d[r] * cov[(r, c)] * d[c];
             }
         }
         Some(Uncertainty {
             covariance,
-            condition_number,
-            weakest_direction,
+            condition_number: cond.condition_number,
+            weakest_direction: cond.weakest_direction,
             residual_sigma: (self.sum_sq / (m.saturating_sub(3).max(1)) as f64).sqrt(),
             inflation,
         })
