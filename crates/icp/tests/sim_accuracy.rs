@@ -3,38 +3,16 @@
 //! and scans 0.4 s apart. Targets of issue 3: RMS ≤ 0.5 mm in x and y and ≤ 0.02° in
 //! θ; 99th percentile ≤ 1.5 mm and ≤ 0.07°.
 
-use odocal_geom::{wrap_angle, Pose2};
-use odocal_icp::{IcpParams, Matcher, PreparedScan};
-use odocal_sim::{simulate, PresetRegistry, SimRun};
-use rand::{rngs::StdRng, SeedableRng};
-use rand_distr::{Distribution, Normal};
+#[path = "common/sim_pairs.rs"]
+mod sim_pairs;
 
-/// A first guess like odometry's: the truth off by 5 % of the motion plus 2 mm / 0.3°.
-fn first_guess(truth: &Pose2, rng: &mut StdRng) -> Pose2 {
-    let unit = Normal::new(0.0, 1.0).expect("unit normal");
-    let sxy = 0.05 * truth.translation_norm() + 0.002;
-    let sth = 0.05 * truth.theta.abs() + 0.3f64.to_radians();
-    Pose2::new(
-        truth.x + sxy * unit.sample(rng),
-        truth.y + sxy * unit.sample(rng),
-        truth.theta + sth * unit.sample(rng),
-    )
-}
+use odocal_sim::SimRun;
+use sim_pairs::{guess_seed, match_pairs, p99, rms, simulate_preset, PairOutcome, GAPS};
 
 struct Stats {
     ex: Vec<f64>,
     ey: Vec<f64>,
     et: Vec<f64>,
-}
-
-fn rms(v: &[f64]) -> f64 {
-    (v.iter().map(|e| e * e).sum::<f64>() / v.len() as f64).sqrt()
-}
-
-fn p99(v: &[f64]) -> f64 {
-    let mut a: Vec<f64> = v.iter().map(|e| e.abs()).collect();
-    a.sort_by(f64::total_cmp);
-    a[((0.99 * a.len() as f64).ceil() as usize).clamp(1, a.len()) - 1]
 }
 
 struct Outcome {
@@ -46,16 +24,6 @@ struct Outcome {
 /// Matches every pair `gap` scans apart; ill-conditioned results (flagged, so not to
 /// be trusted by the caller) are counted but left out of the error statistics.
 fn evaluate(run: &SimRun, gap: usize, seed: u64) -> Outcome {
-    let params = IcpParams::default();
-    let angles = run.config.laser.angles();
-    let (min_r, max_r) = (run.config.laser.min_range, run.config.laser.max_range);
-    let prepared: Vec<PreparedScan> = run
-        .scans
-        .iter()
-        .map(|s| PreparedScan::new(&s.ranges, &angles, min_r, max_r, &params).expect("scan"))
-        .collect();
-    let mut matcher = Matcher::new(params);
-    let mut rng = StdRng::seed_from_u64(seed);
     let mut out = Outcome {
         stats: Stats {
             ex: vec![],
@@ -65,19 +33,15 @@ fn evaluate(run: &SimRun, gap: usize, seed: u64) -> Outcome {
         failures: 0,
         ill_conditioned: 0,
     };
-    for k in 0..run.scans.len() - gap {
-        let truth = run.scans[k].sensor.between(&run.scans[k + gap].sensor);
-        let guess = first_guess(&truth, &mut rng);
-        match matcher.match_scans(&prepared[k], &prepared[k + gap], guess) {
-            Ok(r) if r.ill_conditioned => out.ill_conditioned += 1,
-            Ok(r) => {
-                out.stats.ex.push(r.pose.x - truth.x);
-                out.stats.ey.push(r.pose.y - truth.y);
-                out.stats.et.push(wrap_angle(r.pose.theta - truth.theta));
-            }
-            Err(e) => {
-                eprintln!("pair {k}+{gap}: {e}");
-                out.failures += 1;
+    for pair in match_pairs(run, gap, seed) {
+        match pair.outcome {
+            PairOutcome::IllConditioned => out.ill_conditioned += 1,
+            PairOutcome::Failed => out.failures += 1,
+            PairOutcome::Matched(estimate) => {
+                let [ex, ey, et] = pair.error_of(&estimate);
+                out.stats.ex.push(ex);
+                out.stats.ey.push(ey);
+                out.stats.et.push(et);
             }
         }
     }
@@ -122,19 +86,11 @@ fn misses(
     seed: Option<u64>,
     bounds: &Bounds,
 ) -> Vec<String> {
-    let mut config = PresetRegistry::builtin().get(preset).expect("preset");
-    config.duration = 40.0;
-    if let Some(seed) = seed {
-        config.seed = seed;
-    }
-    let seed = config.seed;
-    if let Some(rays) = correlation_rays {
-        config.laser.correlation_rays = rays;
-    }
-    let sim = simulate(&config).expect("simulation");
+    let sim = simulate_preset(preset, correlation_rays, seed);
+    let seed = sim.config.seed;
     let mut failed = vec![];
-    for (gap, label) in [(1, "10 Hz"), (4, "0.4 s")] {
-        let o = evaluate(&sim, gap, 7 + gap as u64);
+    for (gap, label) in GAPS {
+        let o = evaluate(&sim, gap, guess_seed(gap));
         let s = &o.stats;
         let n = s.ex.len();
         let (rx, ry, rt) = (rms(&s.ex), rms(&s.ey), rms(&s.et).to_degrees());
