@@ -6,7 +6,7 @@
 
 use crate::builder::{LogBuilder, Stream};
 use crate::error::LogError;
-use crate::model::{Log, OdomRecord, ScanGeometry, ScanKind, ValueSource};
+use crate::model::{LaserFields, Log, OdomRecord, ScanGeometry, ScanKind, ValueSource};
 use crate::options::{is_valid_modulus, ReadOptions};
 use crate::tokens::{FieldError, Fields, Tokens};
 use odocal_geom::Pose2;
@@ -52,17 +52,6 @@ impl Message {
             _ => None,
         }
     }
-}
-
-/// The laser geometry fields of a RAWLASER1 / ROBOTLASER1 line.
-struct LaserHeader {
-    laser_type: i32,
-    start_angle: f64,
-    fov: f64,
-    resolution: f64,
-    max_range: f64,
-    accuracy: f64,
-    remission_mode: i32,
 }
 
 /// Parser state across lines.
@@ -269,7 +258,7 @@ impl CarmenReader<'_> {
 
     /// RAWLASER1 and ROBOTLASER1.
     fn laser(&mut self, f: &mut Fields<'_>, msg: Message, line: u64) -> Result<(), FieldError> {
-        let h = LaserHeader {
+        let h = LaserFields {
             laser_type: f.i32("laser_type")?,
             start_angle: f.finite_f64("start_angle")?,
             fov: f.finite_f64("field_of_view")?,
@@ -281,6 +270,7 @@ impl CarmenReader<'_> {
                     Ok(v)
                 }
             })?,
+            min_range: self.min_range(),
             accuracy: f.f64("accuracy")?,
             remission_mode: f.i32("remission_mode")?,
         };
@@ -367,26 +357,17 @@ impl CarmenReader<'_> {
         Self::trailer(f).map_err(|e| explain(e, f, Some(k)))
     }
 
-    /// The index of the geometry described by `h` with `n` rays, reusing a stored one.
-    fn geometry_for(&mut self, h: &LaserHeader, n: usize) -> u32 {
-        let min_range = self
-            .b
+    /// Minimum range of the scans read now: the reader's option, else the log's PARAM.
+    fn min_range(&self) -> f64 {
+        self.b
             .opts
             .min_range
-            .unwrap_or(self.b.log.params.laser_min_range);
-        let fits = |g: &ScanGeometry| {
-            g.has_fields(
-                h.laser_type,
-                h.start_angle,
-                h.fov,
-                h.resolution,
-                h.max_range,
-                min_range,
-                h.accuracy,
-                h.remission_mode,
-                n,
-            )
-        };
+            .unwrap_or(self.b.log.params.laser_min_range)
+    }
+
+    /// The index of the geometry described by `h` with `n` rays, reusing a stored one.
+    fn geometry_for(&mut self, h: &LaserFields, n: usize) -> u32 {
+        let fits = |g: &ScanGeometry| g.has_fields(h, n);
         let store = &mut self.b.log.scans;
         if let Some(i) = self.last_geometry {
             if fits(&store.geometries[i as usize]) {
@@ -396,17 +377,7 @@ impl CarmenReader<'_> {
         let i = match store.geometries.iter().position(fits) {
             Some(i) => i as u32,
             None => {
-                store.geometries.push(ScanGeometry::new(
-                    h.laser_type,
-                    h.start_angle,
-                    h.fov,
-                    h.resolution,
-                    h.max_range,
-                    min_range,
-                    h.accuracy,
-                    h.remission_mode,
-                    n,
-                ));
+                store.geometries.push(ScanGeometry::new(*h, n));
                 (store.geometries.len() - 1) as u32
             }
         };
@@ -464,12 +435,13 @@ impl CarmenReader<'_> {
             None if n > 1 => fov / n_f,
             None => 0.0,
         };
-        let h = LaserHeader {
+        let h = LaserFields {
             laser_type: 0,
             start_angle: -0.5 * n_f * resolution,
             fov: n_f * resolution,
             resolution,
             max_range: self.flaser_max_range,
+            min_range: self.min_range(),
             accuracy: 0.0,
             remission_mode: 0,
         };

@@ -117,6 +117,29 @@ pub struct ScanGeometry {
     pub angles: Arc<[f64]>,
 }
 
+/// The fields a laser line logs about its geometry (RAWLASER1 / ROBOTLASER1 order;
+/// `min_range` comes from a PARAM or the reader's options): what a [`ScanGeometry`] is
+/// built from, before its angle table.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LaserFields {
+    /// Laser type code (2 = Hokuyo URG); 0 when unknown.
+    pub laser_type: i32,
+    /// Angle of ray 0 (rad).
+    pub start_angle: f64,
+    /// Field of view (rad).
+    pub fov: f64,
+    /// Angle between consecutive rays (rad).
+    pub resolution: f64,
+    /// Maximum range (m).
+    pub max_range: f64,
+    /// Minimum range (m).
+    pub min_range: f64,
+    /// Accuracy field (m).
+    pub accuracy: f64,
+    /// Remission mode.
+    pub remission_mode: i32,
+}
+
 /// True when `a` and `b` are the same number, NaN included (geometries compare by bits
 /// so that a NaN field cannot make a geometry unequal to itself).
 fn same_f64(a: f64, b: f64) -> bool {
@@ -124,31 +147,21 @@ fn same_f64(a: f64, b: f64) -> bool {
 }
 
 impl ScanGeometry {
-    /// A geometry with its angle table computed from `start_angle` and `resolution`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        laser_type: i32,
-        start_angle: f64,
-        fov: f64,
-        resolution: f64,
-        max_range: f64,
-        min_range: f64,
-        accuracy: f64,
-        remission_mode: i32,
-        num_readings: usize,
-    ) -> Self {
+    /// A geometry with `num_readings` rays, its angle table computed from the fields
+    /// `start_angle` and `resolution`.
+    pub fn new(fields: LaserFields, num_readings: usize) -> Self {
         let angles: Arc<[f64]> = (0..num_readings)
-            .map(|i| start_angle + i as f64 * resolution)
+            .map(|i| fields.start_angle + i as f64 * fields.resolution)
             .collect();
         ScanGeometry {
-            laser_type,
-            start_angle,
-            resolution,
-            fov,
-            max_range,
-            min_range,
-            accuracy,
-            remission_mode,
+            laser_type: fields.laser_type,
+            start_angle: fields.start_angle,
+            resolution: fields.resolution,
+            fov: fields.fov,
+            max_range: fields.max_range,
+            min_range: fields.min_range,
+            accuracy: fields.accuracy,
+            remission_mode: fields.remission_mode,
             angles,
         }
     }
@@ -157,7 +170,17 @@ impl ScanGeometry {
     /// apart, starting at −340·2π/1024, maximum range 4 m.
     pub fn urg_04lx() -> Self {
         let res = std::f64::consts::TAU / 1024.0;
-        ScanGeometry::new(2, -340.0 * res, 680.0 * res, res, 4.0, 0.02, 0.01, 0, 681)
+        let fields = LaserFields {
+            laser_type: 2,
+            start_angle: -340.0 * res,
+            fov: 680.0 * res,
+            resolution: res,
+            max_range: 4.0,
+            min_range: 0.02,
+            accuracy: 0.01,
+            remission_mode: 0,
+        };
+        ScanGeometry::new(fields, 681)
     }
 
     /// A geometry with an explicit angle table (rays need not be evenly spaced, as in
@@ -194,30 +217,18 @@ impl ScanGeometry {
             .all(|(i, &a)| same_f64(a, self.start_angle + i as f64 * self.resolution))
     }
 
-    /// True when the logged fields equal the given ones (the angle table is then equal
-    /// too, being computed from them). Used by the reader to reuse a geometry without
-    /// building a new angle table.
-    #[allow(clippy::too_many_arguments)]
-    pub fn has_fields(
-        &self,
-        laser_type: i32,
-        start_angle: f64,
-        fov: f64,
-        resolution: f64,
-        max_range: f64,
-        min_range: f64,
-        accuracy: f64,
-        remission_mode: i32,
-        num_readings: usize,
-    ) -> bool {
-        self.laser_type == laser_type
-            && same_f64(self.start_angle, start_angle)
-            && same_f64(self.fov, fov)
-            && same_f64(self.resolution, resolution)
-            && same_f64(self.max_range, max_range)
-            && same_f64(self.min_range, min_range)
-            && same_f64(self.accuracy, accuracy)
-            && self.remission_mode == remission_mode
+    /// True when the logged fields equal `fields` and there are `num_readings` rays (the
+    /// angle table is then equal too, being computed from them). Used by the reader to
+    /// reuse a geometry without building a new angle table.
+    pub fn has_fields(&self, fields: &LaserFields, num_readings: usize) -> bool {
+        self.laser_type == fields.laser_type
+            && same_f64(self.start_angle, fields.start_angle)
+            && same_f64(self.fov, fields.fov)
+            && same_f64(self.resolution, fields.resolution)
+            && same_f64(self.max_range, fields.max_range)
+            && same_f64(self.min_range, fields.min_range)
+            && same_f64(self.accuracy, fields.accuracy)
+            && self.remission_mode == fields.remission_mode
             && self.num_readings() == num_readings
     }
 

@@ -3,8 +3,8 @@
 
 use odocal_geom::Pose2;
 use odocal_log::{
-    read_carmen_from, write_log, LogWriter, OdomRecord, ReadOptions, RobotLaserPoses, ScanGeometry,
-    ScanKind,
+    read_carmen_from, write_log, LaserFields, LogWriter, OdomRecord, ReadOptions, RobotLaserPoses,
+    ScanGeometry, ScanKind,
 };
 use proptest::prelude::*;
 
@@ -37,17 +37,17 @@ fn geometry_strategy() -> impl Strategy<Value = ScanGeometry> {
         0usize..40,
     )
         .prop_map(|(lt, start, res, max, acc, rm, n)| {
-            ScanGeometry::new(
-                lt,
-                start,
-                n.saturating_sub(1) as f64 * res,
-                res,
-                max,
-                0.02,
-                acc,
-                rm,
-                n,
-            )
+            let fields = LaserFields {
+                laser_type: lt,
+                start_angle: start,
+                fov: n.saturating_sub(1) as f64 * res,
+                resolution: res,
+                max_range: max,
+                min_range: 0.02,
+                accuracy: acc,
+                remission_mode: rm,
+            };
+            ScanGeometry::new(fields, n)
         })
 }
 

@@ -5,7 +5,7 @@
 use crate::error::SimError;
 use crate::world::World;
 use odocal_geom::Pose2;
-use odocal_log::ScanGeometry;
+use odocal_log::{LaserFields, ScanGeometry};
 use rand::Rng;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
@@ -74,17 +74,17 @@ impl LaserConfig {
 
     /// The scan geometry as written to the log (laser type 2 = Hokuyo URG).
     pub fn geometry(&self) -> ScanGeometry {
-        ScanGeometry::new(
-            2,
-            self.start_angle,
-            (self.num_rays.saturating_sub(1)) as f64 * self.resolution,
-            self.resolution,
-            self.max_range,
-            self.min_range,
-            self.range_sigma,
-            0,
-            self.num_rays,
-        )
+        let fields = LaserFields {
+            laser_type: 2,
+            start_angle: self.start_angle,
+            fov: (self.num_rays.saturating_sub(1)) as f64 * self.resolution,
+            resolution: self.resolution,
+            max_range: self.max_range,
+            min_range: self.min_range,
+            accuracy: self.range_sigma,
+            remission_mode: 0,
+        };
+        ScanGeometry::new(fields, self.num_rays)
     }
 
     /// Ray angles in the sensor frame (rad).
