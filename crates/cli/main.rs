@@ -10,7 +10,9 @@ use std::process::ExitCode;
 
 mod calibrate;
 mod info;
+mod input;
 mod matching;
+mod progress_bar;
 mod simulate;
 mod solve;
 mod table_i;

@@ -162,7 +162,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     let (rows, notes) = load_rows(&args)?;
-    let pool = crate::calibrate::thread_pool(args.threads)?;
+    let pool = crate::input::thread_pool(args.threads)?;
     let tol = Tolerances::default();
     let opts = Options::default();
     let mut reproductions: Vec<Reproduction> = Vec::new();
