@@ -104,6 +104,15 @@ pub(crate) struct RawOdometry {
 }
 
 impl RawOdometry {
+    /// No motion: where the integration of an interval starts.
+    const ZERO: RawOdometry = RawOdometry {
+        x: 0.0,
+        y: 0.0,
+        theta: 0.0,
+        sin: 0.0,
+        cos: 1.0,
+    };
+
     /// `1 − cos theta` without cancellation for small angles.
     #[inline]
     pub(crate) fn one_minus_cos(&self) -> f64 {
@@ -135,13 +144,7 @@ pub(crate) fn odometry_raw(
     b: f64,
     pieces: impl Iterator<Item = (f64, f64)>,
 ) -> RawOdometry {
-    let mut o = RawOdometry {
-        x: 0.0,
-        y: 0.0,
-        theta: 0.0,
-        sin: 0.0,
-        cos: 1.0,
-    };
+    let mut o = RawOdometry::ZERO;
     for (al, ar) in pieces {
         let ds = 0.5 * (r_l * al + r_r * ar);
         let dth = (r_r * ar - r_l * al) / b;
@@ -165,13 +168,7 @@ pub(crate) fn odometry_with_jacobian(
     b: f64,
     pieces: impl Iterator<Item = (f64, f64)>,
 ) -> (RawOdometry, [[f64; 3]; 3]) {
-    let mut o = RawOdometry {
-        x: 0.0,
-        y: 0.0,
-        theta: 0.0,
-        sin: 0.0,
-        cos: 1.0,
-    };
+    let mut o = RawOdometry::ZERO;
     let mut d = [[0.0; 3]; 3];
     let inv_b = 1.0 / b;
     for (al, ar) in pieces {
