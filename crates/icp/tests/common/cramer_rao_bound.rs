@@ -13,6 +13,10 @@
 //! the variance `q²/12` of the rounding to `q` on the diagonal; scans are
 //! independent. Fisher information `F = Σ_scans Jᵀ Σ⁻¹ J`; the bound on `s` is the
 //! 3×3 block of `F⁻¹`, i.e. the inverse of the Schur complement of the wall block.
+//! The rounding is taken as independent Gaussian noise of its variance (with
+//! σ = 3 mm ≫ 1 mm the rounding errors are close to independent and uniform); on the
+//! correlated model it is the only noise at the frequencies where the moving sum's
+//! spectrum vanishes, so the bound depends on it (see `tests/cramer_rao.rs`).
 //!
 //! Include with `#[path = "common/cramer_rao_bound.rs"] mod cramer_rao_bound;`.
 #![allow(dead_code)]
@@ -278,14 +282,16 @@ pub fn range_gradient(pose: [f64; 3], line: [f64; 2], angle: f64) -> ([f64; 3], 
 pub struct PairBound {
     /// CRB of `(x, y, θ)` (m², rad²).
     pub covariance: Matrix3<f64>,
+    /// Its inverse: the pose information left once the walls are estimated.
+    pub information: Matrix3<f64>,
     /// Covariance of `(x, y, θ)` estimated by ordinary least squares on the same
     /// rays and model (walls unknown), i.e. with the noise taken as independent, under
     /// the true noise: the floor of a matcher that does not model the correlation
     /// (equal to `covariance` for independent noise).
     pub least_squares_covariance: Matrix3<f64>,
-    /// Its inverse: the pose information left once the walls are estimated.
-    pub information: Matrix3<f64>,
-    /// Lines read by both scans (only they carry pose information).
+    /// Lines read by both scans (the pose information comes from them; a line read
+    /// by one scan only tells nothing about the pose, except, with correlated noise,
+    /// through what its rays reveal of their neighbours' noise).
     pub shared_lines: usize,
     /// Rays used, per scan.
     pub rays: [usize; 2],
@@ -294,11 +300,120 @@ pub struct PairBound {
     pub max_range_mismatch: f64,
 }
 
-/// The CRB of the displacement from the scan at `first` (world frame) to the scan at
-/// `second`, given their readable rays (see [`wall_hits`]). A line read by fewer than
+/// The unknowns of a pair and the rays that inform them. A line read by fewer than
 /// three rays of the pair is left out with its rays: its two parameters absorb them
 /// exactly, which is the same as not having them (the noise of the others is then
-/// that of the restricted covariance). `None` when the information is singular.
+/// that of the restricted covariance).
+struct PairModel<'a> {
+    /// Per line: the column of its `α` (`d` is next), `usize::MAX` when left out.
+    column: Vec<usize>,
+    /// Number of unknowns: the pose, then two per line kept.
+    params: usize,
+    /// Per scan: the rays used.
+    used: [Vec<&'a WallHit>; 2],
+    /// Lines read by both scans.
+    shared_lines: usize,
+}
+
+impl<'a> PairModel<'a> {
+    fn new(lines: &WallLines, hits: [&'a [WallHit]; 2]) -> Self {
+        let mut per_line = vec![[0usize; 2]; lines.len()];
+        for (scan, hits) in hits.iter().enumerate() {
+            for h in hits.iter() {
+                per_line[h.line][scan] += 1;
+            }
+        }
+        let mut column = vec![usize::MAX; lines.len()];
+        let mut params = 3;
+        for (id, c) in per_line.iter().enumerate() {
+            if c[0] + c[1] >= 3 {
+                column[id] = params;
+                params += 2;
+            }
+        }
+        let shared_lines = per_line
+            .iter()
+            .filter(|c| c[0] > 0 && c[1] > 0 && c[0] + c[1] >= 3)
+            .count();
+        let used = hits.map(|h| h.iter().filter(|h| column[h.line] != usize::MAX).collect());
+        PairModel {
+            column,
+            params,
+            used,
+            shared_lines,
+        }
+    }
+
+    /// The unknowns at the truth: the relative pose, and every kept line in the
+    /// first scan's frame.
+    fn truth(&self, lines: &WallLines, first: &Pose2, second: &Pose2) -> Vec<f64> {
+        let relative = first.between(second);
+        let mut x = vec![0.0; self.params];
+        x[..3].copy_from_slice(&[relative.x, relative.y, relative.theta]);
+        for (id, &c) in self.column.iter().enumerate() {
+            if c != usize::MAX {
+                x[c..c + 2].copy_from_slice(&lines.in_frame(id, first));
+            }
+        }
+        x
+    }
+
+    /// Predicted ranges of the rays of `scan` and their Jacobian at the unknowns `x`.
+    fn ranges(&self, scan: usize, x: &[f64], angles: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
+        let at = if scan == 0 {
+            [0.0; 3]
+        } else {
+            [x[0], x[1], x[2]]
+        };
+        let used = &self.used[scan];
+        let mut jacobian = DMatrix::<f64>::zeros(used.len(), self.params);
+        let mut predicted = Vec::with_capacity(used.len());
+        for (row, h) in used.iter().enumerate() {
+            let c = self.column[h.line];
+            let line = [x[c], x[c + 1]];
+            let angle = angles[h.ray];
+            predicted.push(range_to_line(at, line, angle));
+            let (d_pose, d_line) = range_gradient(at, line, angle);
+            if scan == 1 {
+                for (k, v) in d_pose.iter().enumerate() {
+                    jacobian[(row, k)] = *v;
+                }
+            }
+            jacobian[(row, c)] = d_line[0];
+            jacobian[(row, c + 1)] = d_line[1];
+        }
+        (predicted, jacobian)
+    }
+
+    /// Ray indices of the rays of `scan`.
+    fn rays(&self, scan: usize) -> Vec<usize> {
+        self.used[scan].iter().map(|h| h.ray).collect()
+    }
+}
+
+/// The 3×3 pose block of the inverse of `m` (pose first): the inverse of the Schur
+/// complement of the rest.
+fn pose_information(m: &DMatrix<f64>) -> Option<Matrix3<f64>> {
+    let rest = m.nrows() - 3;
+    let pose_block = m.view((0, 0), (3, 3)).into_owned();
+    let schur = if rest == 0 {
+        pose_block
+    } else {
+        let cross = m.view((0, 3), (3, rest)).into_owned();
+        let solved = m
+            .view((3, 3), (rest, rest))
+            .into_owned()
+            .cholesky()?
+            .solve(&cross.transpose());
+        pose_block - &cross * solved
+    };
+    let information = Matrix3::from_iterator(schur.iter().copied());
+    Some(0.5 * (information + information.transpose()))
+}
+
+/// The CRB of the displacement from the scan at `first` (world frame) to the scan at
+/// `second`, given their readable rays (see [`wall_hits`]); `None` when the
+/// information is singular.
 pub fn pair_bound(
     lines: &WallLines,
     noise: &RangeNoise,
@@ -306,86 +421,103 @@ pub fn pair_bound(
     first: (&Pose2, &[WallHit]),
     second: (&Pose2, &[WallHit]),
 ) -> Option<PairBound> {
-    let relative = first.0.between(second.0);
-    let pose = [relative.x, relative.y, relative.theta];
-    let mut hits_per_line = vec![[0usize; 2]; lines.len()];
-    for (scan, hits) in [first.1, second.1].iter().enumerate() {
-        for h in hits.iter() {
-            hits_per_line[h.line][scan] += 1;
-        }
-    }
-    let mut column = vec![usize::MAX; lines.len()];
-    let mut params = 3;
-    for (id, c) in hits_per_line.iter().enumerate() {
-        if c[0] + c[1] >= 3 {
-            column[id] = params;
-            params += 2;
-        }
-    }
-    let shared_lines = hits_per_line
-        .iter()
-        .filter(|c| c[0] > 0 && c[1] > 0 && c[0] + c[1] >= 3)
-        .count();
-    let mut fisher = DMatrix::<f64>::zeros(params, params);
-    let mut normal = DMatrix::<f64>::zeros(params, params);
-    let mut meat = DMatrix::<f64>::zeros(params, params);
-    let mut rays = [0; 2];
+    let model = PairModel::new(lines, [first.1, second.1]);
+    let truth = model.truth(lines, first.0, second.0);
+    let n = model.params;
+    let (mut fisher, mut normal, mut meat) = (
+        DMatrix::<f64>::zeros(n, n),
+        DMatrix::<f64>::zeros(n, n),
+        DMatrix::<f64>::zeros(n, n),
+    );
     let mut max_range_mismatch = 0.0f64;
-    for (scan, hits) in [first.1, second.1].iter().enumerate() {
-        let used: Vec<&WallHit> = hits
-            .iter()
-            .filter(|h| column[h.line] != usize::MAX)
-            .collect();
-        rays[scan] = used.len();
-        if used.is_empty() {
+    for scan in 0..2 {
+        if model.used[scan].is_empty() {
             continue;
         }
-        let at = if scan == 0 { [0.0; 3] } else { pose };
-        let mut jacobian = DMatrix::<f64>::zeros(used.len(), params);
-        for (row, h) in used.iter().enumerate() {
-            let line = lines.in_frame(h.line, first.0);
-            let angle = angles[h.ray];
-            max_range_mismatch =
-                max_range_mismatch.max((range_to_line(at, line, angle) - h.range).abs());
-            let (d_pose, d_line) = range_gradient(at, line, angle);
-            if scan == 1 {
-                for (c, v) in d_pose.iter().enumerate() {
-                    jacobian[(row, c)] = *v;
-                }
-            }
-            jacobian[(row, column[h.line])] = d_line[0];
-            jacobian[(row, column[h.line] + 1)] = d_line[1];
+        let (predicted, mut jacobian) = model.ranges(scan, &truth, angles);
+        for (p, h) in predicted.iter().zip(&model.used[scan]) {
+            max_range_mismatch = max_range_mismatch.max((p - h.range).abs());
         }
-        let ray_indices: Vec<usize> = used.iter().map(|h| h.ray).collect();
+        let rays = model.rays(scan);
         normal += jacobian.transpose() * &jacobian;
-        meat += jacobian.transpose() * noise.covariance_times(&ray_indices, &jacobian);
-        BandedCholesky::of_rays(noise, &ray_indices)?.whiten(&mut jacobian);
+        meat += jacobian.transpose() * noise.covariance_times(&rays, &jacobian);
+        BandedCholesky::of_rays(noise, &rays)?.whiten(&mut jacobian);
         fisher += jacobian.transpose() * &jacobian;
     }
-    let walls = params - 3;
-    let pose_block = fisher.view((0, 0), (3, 3)).into_owned();
-    let cross = fisher.view((0, 3), (3, walls)).into_owned();
-    let wall_block = fisher.view((3, 3), (walls, walls)).into_owned();
-    let schur = if walls == 0 {
-        pose_block
-    } else {
-        let solved = wall_block.cholesky()?.solve(&cross.transpose());
-        pose_block - &cross * solved
-    };
-    let information = Matrix3::from_iterator(schur.iter().copied());
-    let information = 0.5 * (information + information.transpose());
+    let information = pose_information(&fisher)?;
     let covariance = information.cholesky()?.inverse();
-    let normal_solve = normal.cholesky()?;
-    let sandwich = normal_solve.solve(&normal_solve.solve(&meat).transpose());
-    let least_squares_covariance = sandwich.fixed_view::<3, 3>(0, 0).into_owned();
+    let normal = normal.cholesky()?;
+    let sandwich = normal.solve(&normal.solve(&meat).transpose());
     Some(PairBound {
         covariance,
-        least_squares_covariance,
+        least_squares_covariance: sandwich.fixed_view::<3, 3>(0, 0).into_owned(),
         information,
-        shared_lines,
-        rays,
+        shared_lines: model.shared_lines,
+        rays: [model.used[0].len(), model.used[1].len()],
         max_range_mismatch,
     })
+}
+
+/// How an [`oracle_estimate`] weighs the ranges.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Weighting {
+    /// By the inverse noise covariance (generalised least squares: maximum
+    /// likelihood under the Gaussian model).
+    Covariance,
+    /// Equally (ordinary least squares: the noise taken as independent).
+    Equal,
+}
+
+/// The displacement estimated from the readings (`ranges` of each scan, m) by an
+/// oracle that knows which wall line each ray reads and that walls are straight, but
+/// neither the pose nor the lines: Gauss–Newton on all the unknowns from the truth,
+/// to convergence. It shows what the bound's model lets an estimator reach on the
+/// simulated data (rounding and all). `None` when a system is singular.
+pub fn oracle_estimate(
+    lines: &WallLines,
+    noise: &RangeNoise,
+    angles: &[f64],
+    first: (&Pose2, &[WallHit], &[f32]),
+    second: (&Pose2, &[WallHit], &[f32]),
+    weighting: Weighting,
+) -> Option<Pose2> {
+    let model = PairModel::new(lines, [first.1, second.1]);
+    let mut x = model.truth(lines, first.0, second.0);
+    let readings = [first.2, second.2];
+    let factors = [0, 1].map(|scan| BandedCholesky::of_rays(noise, &model.rays(scan)));
+    for _ in 0..10 {
+        let mut normal = DMatrix::<f64>::zeros(model.params, model.params);
+        let mut gradient = DMatrix::<f64>::zeros(model.params, 1);
+        for scan in 0..2 {
+            if model.used[scan].is_empty() {
+                continue;
+            }
+            let (predicted, mut jacobian) = model.ranges(scan, &x, angles);
+            let mut residual = DMatrix::from_iterator(
+                predicted.len(),
+                1,
+                model.used[scan]
+                    .iter()
+                    .zip(&predicted)
+                    .map(|(h, p)| readings[scan][h.ray] as f64 - p),
+            );
+            if weighting == Weighting::Covariance {
+                let factor = factors[scan].as_ref()?;
+                factor.whiten(&mut jacobian);
+                factor.whiten(&mut residual);
+            }
+            normal += jacobian.transpose() * &jacobian;
+            gradient += jacobian.transpose() * residual;
+        }
+        let step = normal.cholesky()?.solve(&gradient);
+        for (v, d) in x.iter_mut().zip(step.iter()) {
+            *v += d;
+        }
+        if step.rows(0, 3).norm() < 1e-12 {
+            break;
+        }
+    }
+    Some(Pose2::new(x[0], x[1], x[2]))
 }
 
 fn unit(angle: f64) -> [f64; 2] {
