@@ -224,7 +224,7 @@ fn comparisons(
 /// preset seed and seeds 2 and 3 (docs/benchmarks.md, icp, Accuracy), the matcher is
 /// at 1.04–1.22 × the floor with independent noise and 1.17–1.65 × with the default
 /// correlated noise (the matcher treats the noise as independent: it is at
-/// 0.99–1.14 × the least-squares floor, which is itself 1.1–1.55 × the CRB there).
+/// 0.99–1.14 × the least-squares floor, which is itself 1.09–1.54 × the CRB there).
 /// The limits leave about 15 % to those worst ratios.
 fn efficiency_limit(correlated: bool) -> f64 {
     if correlated {
@@ -235,8 +235,9 @@ fn efficiency_limit(correlated: bool) -> f64 {
 }
 
 /// How far above the least-squares floor (the best estimator that takes the noise
-/// as independent) the matcher may be: measured 0.99–1.14 × on the same cases, limit
-/// with about 15 % to spare.
+/// as independent) the matcher may be on the correlated-noise sensor: measured
+/// 0.99–1.14 ×, limit with about 15 % to spare. (With independent noise that floor
+/// is the CRB floor, see [`efficiency_limit`].)
 const LEAST_SQUARES_LIMIT: f64 = 1.3;
 
 /// The GLS oracle's RMS error / CRB floor, measured 0.92–1.10 on the preset seed and
@@ -282,7 +283,7 @@ fn check(c: &Comparison) {
             c.floor[k]
         );
         assert!(
-            ratio_ls <= LEAST_SQUARES_LIMIT,
+            !c.correlated || ratio_ls <= LEAST_SQUARES_LIMIT,
             "{} {axis}: measured RMS {:.3e} is {ratio_ls:.2} × the least-squares floor {:.3e}",
             c.label,
             c.measured[k],
