@@ -152,12 +152,12 @@ fn compare(run: &SimRun, gap: usize, label: String, noise: &RangeNoise) -> Compa
             continue;
         };
         let e = Vector3::from(e);
-        let (all, limited) = (
+        let (all, without_grazing) = (
             bound(pair.first, pair.second, &hits),
             bound(pair.first, pair.second, &not_grazing),
         );
         variances[0] += all.covariance;
-        variances[1] += limited.covariance;
+        variances[1] += without_grazing.covariance;
         variances[2] += all.least_squares_covariance;
         squared_errors += e.component_mul(&e);
         for (sum, weighting) in oracle_squared_errors
