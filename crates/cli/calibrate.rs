@@ -107,7 +107,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let initial_params = args.nominal.as_deref().map(nominal_params).transpose()?;
     let mut opts = Options {
         initial_params,
-        ticks_per_revolution: input.ticks_per_rev,
+        ticks_per_revolution: input.read.ticks_per_rev,
         stride: input.stride,
         use_profile: !args.constant_speed,
         use_icp_covariance: args.icp_covariance,
@@ -124,7 +124,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let bar = Bar::for_stderr();
     let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
     outcome.timing.parse = parse_s;
-    let report = build_report(&input.log, &log, &opts, &outcome);
+    let report = build_report(&input.read.log, &log, &opts, &outcome);
 
     if let Some(dir) = &args.out {
         write_outputs(dir, &opts, &outcome, &report, args.plots)

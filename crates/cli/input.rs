@@ -1,18 +1,16 @@
 //! The arguments `calibrate` and `match` share: the log and how to read it, how to
 //! pair its scans, and how many threads match them.
 
+use crate::read_args::ReadArgs;
 use anyhow::Context;
-use odocal_log::{read_log, Log, Mode, ReadOptions};
-use std::path::PathBuf;
+use odocal_log::Log;
 
 /// The input log and the options of reading, pairing and matching it.
 #[derive(clap::Args, Debug)]
 pub struct InputArgs {
-    /// The log (Carmen-style text with ENCODER lines, or the original package's JSON log).
-    pub log: PathBuf,
-    /// Encoder ticks per wheel revolution (overrides the log's PARAM).
-    #[arg(long, value_name = "X")]
-    pub ticks_per_rev: Option<f64>,
+    /// The log and how to read it.
+    #[command(flatten)]
+    pub read: ReadArgs,
     /// Pair scans K apart (default: about 0.4 s apart at the log's scan rate).
     #[arg(long, value_name = "K")]
     pub stride: Option<usize>,
@@ -27,9 +25,6 @@ pub struct InputArgs {
     /// Threads for scan matching (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
-    /// Skip malformed lines (counted and reported) instead of stopping at the first.
-    #[arg(long)]
-    pub lenient: bool,
 }
 
 impl InputArgs {
@@ -38,19 +33,9 @@ impl InputArgs {
         thread_pool(self.threads)
     }
 
-    /// Reads the log, strict unless `--lenient`, with the `--ticks-per-rev` override.
+    /// Reads the log with the reading options of [`ReadArgs`].
     pub fn read_log(&self) -> anyhow::Result<Log> {
-        let opts = ReadOptions {
-            mode: if self.lenient {
-                Mode::Lenient
-            } else {
-                Mode::Strict
-            },
-            ticks_per_revolution: self.ticks_per_rev,
-            ..ReadOptions::default()
-        };
-        // The reader's message already says everything (file, line, cause).
-        read_log(&self.log, &opts).map_err(|e| anyhow::anyhow!("{e}"))
+        self.read.read_log()
     }
 }
 

@@ -13,6 +13,7 @@ mod info;
 mod input;
 mod matching;
 mod progress_bar;
+mod read_args;
 mod simulate;
 mod solve;
 mod table_i;

@@ -23,7 +23,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let pool = input.thread_pool()?;
     let log = input.read_log()?;
     let opts = Options {
-        ticks_per_revolution: input.ticks_per_rev,
+        ticks_per_revolution: input.read.ticks_per_rev,
         stride: input.stride,
         time_offset: input.time_offset,
         ..Options::default()

@@ -165,9 +165,16 @@ impl<'o> LogBuilder<'o> {
         if let Some(r) = opts.min_range {
             log.params.laser_min_range = r;
         }
+        if let Some(dt) = opts.time_increment {
+            log.params.laser_time_increment = Some(dt);
+        }
         let min_range = log.params.laser_min_range;
+        let time_increment = log.params.laser_time_increment;
         for g in &mut log.scans.geometries {
             g.min_range = min_range;
+            if let Some(dt) = time_increment {
+                g.time_increment = dt;
+            }
         }
         for (k, o) in self.order.iter().enumerate() {
             if o.out_of_order == 0 {

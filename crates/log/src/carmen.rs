@@ -213,6 +213,14 @@ impl CarmenReader<'_> {
                     .ok_or_else(|| bad("angular resolution (a positive number, rad)"))?;
                 params.flaser_resolution = Some(v);
             }
+            b"laser_front_laser_time_increment" => {
+                let v = value()
+                    .filter(|v| v.is_finite() && v.abs() < 1.0)
+                    .ok_or_else(|| {
+                        bad("time between rays (a finite number of seconds, |x| < 1)")
+                    })?;
+                params.laser_time_increment = Some(v);
+            }
             b"laser_front_laser_max_range" => {
                 let v = value()
                     .filter(|v| *v > 0.0)

@@ -31,6 +31,9 @@ pub struct Params {
     pub flaser_fov: Option<f64>,
     /// Angular resolution (rad) for `FLASER` scans, when given by a PARAM.
     pub flaser_resolution: Option<f64>,
+    /// Seconds between two consecutive rays of a scan (`laser_front_laser_time_increment`
+    /// or the command line); `None`: every ray at the scan's timestamp.
+    pub laser_time_increment: Option<f64>,
     /// Every PARAM seen, name → last value token.
     pub all: BTreeMap<String, String>,
 }
@@ -43,6 +46,7 @@ impl Default for Params {
             laser_min_range: 0.02,
             flaser_fov: None,
             flaser_resolution: None,
+            laser_time_increment: None,
             all: BTreeMap::new(),
         }
     }
@@ -113,6 +117,14 @@ pub struct ScanGeometry {
     pub accuracy: f64,
     /// Remission mode as logged.
     pub remission_mode: i32,
+    /// Seconds between two consecutive rays (the sweep; ROS `time_increment`, Carmen
+    /// `laser_front_laser_time_increment`). Ray `i` was taken at the scan's timestamp
+    /// plus `i · time_increment`; 0 means every ray at the timestamp. Negative values
+    /// (a driver that stamps the last ray) are kept as logged.
+    pub time_increment: f64,
+    /// Seconds between two scans as the driver reports it (ROS `scan_time`); 0 when
+    /// unknown.
+    pub scan_time: f64,
     /// Ray angles (rad), one per reading.
     pub angles: Arc<[f64]>,
 }
@@ -162,8 +174,28 @@ impl ScanGeometry {
             min_range: fields.min_range,
             accuracy: fields.accuracy,
             remission_mode: fields.remission_mode,
+            time_increment: 0.0,
+            scan_time: 0.0,
             angles,
         }
+    }
+
+    /// The same geometry with the sweep timing set: `time_increment` seconds between
+    /// consecutive rays and `scan_time` seconds between scans (0 when unknown).
+    pub fn with_timing(mut self, time_increment: f64, scan_time: f64) -> Self {
+        self.time_increment = time_increment;
+        self.scan_time = scan_time;
+        self
+    }
+
+    /// Time (s) from the scan's timestamp to ray `i`: `i · time_increment`.
+    pub fn ray_time_offset(&self, i: usize) -> f64 {
+        i as f64 * self.time_increment
+    }
+
+    /// Duration (s) of one sweep, first ray to last: `(n − 1) · time_increment`.
+    pub fn sweep_duration(&self) -> f64 {
+        self.num_readings().saturating_sub(1) as f64 * self.time_increment
     }
 
     /// The Hokuyo URG-04LX as logged by the reference robot: 681 rays, 2π/1024 rad
@@ -204,6 +236,8 @@ impl ScanGeometry {
             min_range,
             accuracy: 0.0,
             remission_mode: 0,
+            time_increment: 0.0,
+            scan_time: 0.0,
             angles: angles.into(),
         }
     }
@@ -230,6 +264,8 @@ impl ScanGeometry {
             && same_f64(self.accuracy, fields.accuracy)
             && self.remission_mode == fields.remission_mode
             && self.num_readings() == num_readings
+            && self.time_increment == 0.0
+            && self.scan_time == 0.0
     }
 
     /// Number of readings per scan.
@@ -251,6 +287,7 @@ impl ScanGeometry {
             && self.resolution == other.resolution
             && self.max_range == other.max_range
             && self.min_range == other.min_range
+            && self.time_increment == other.time_increment
     }
 }
 

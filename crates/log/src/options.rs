@@ -21,6 +21,9 @@ pub struct ReadOptions {
     pub encoder_modulus: Option<f64>,
     /// Minimum valid range in metres (overrides `laser_front_laser_min_range`).
     pub min_range: Option<f64>,
+    /// Seconds between consecutive rays of a scan (overrides
+    /// `laser_front_laser_time_increment` and a bag's `time_increment`).
+    pub time_increment: Option<f64>,
 }
 
 impl ReadOptions {
@@ -47,6 +50,11 @@ impl ReadOptions {
         if let Some(r) = self.min_range {
             if !(r.is_finite() && r >= 0.0) {
                 return Some(("minimum range", "a finite number ≥ 0"));
+            }
+        }
+        if let Some(dt) = self.time_increment {
+            if !(dt.is_finite() && dt.abs() < 1.0) {
+                return Some(("time increment", "a finite number of seconds, |x| < 1"));
             }
         }
         None

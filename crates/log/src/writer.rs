@@ -263,7 +263,7 @@ pub fn write_log<W: Write>(w: W, log: &Log) -> io::Result<()> {
     for (name, value) in &p.all {
         out.param(name, value)?;
     }
-    let typed: [(&str, Option<f64>); 4] = [
+    let typed: [(&str, Option<f64>); 5] = [
         (
             "robot_wheel_ticks_per_revolution",
             p.ticks_per_revolution.as_ref().map(|(v, _)| *v),
@@ -271,6 +271,17 @@ pub fn write_log<W: Write>(w: W, log: &Log) -> io::Result<()> {
         ("robot_encoder_modulus", p.encoder_modulus),
         ("laser_front_laser_fov", p.flaser_fov),
         ("laser_front_laser_resolution", p.flaser_resolution),
+        (
+            "laser_front_laser_time_increment",
+            p.laser_time_increment.or_else(|| {
+                let dt = log
+                    .scans
+                    .geometries
+                    .first()
+                    .map_or(0.0, |g| g.time_increment);
+                (dt != 0.0).then_some(dt)
+            }),
+        ),
     ];
     for (name, value) in typed {
         if let (Some(v), false) = (value, p.all.contains_key(name)) {

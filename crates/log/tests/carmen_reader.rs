@@ -631,3 +631,32 @@ fn stored_scans_cost_about_their_ranges() {
     );
     assert_eq!(log.scans.get(299).unwrap().ranges, &ranges[..]);
 }
+
+#[test]
+fn time_increment_param_sets_every_geometry_and_round_trips() {
+    let text = "RAWLASER1 2 -0.1 0.2 0.1 4.0 0.01 0 3 1.0 1.1 1.2 0 10.0 h 10.0\n\
+                PARAM laser_front_laser_time_increment 9.765625e-5 h 0\n";
+    let log = read_carmen_from(text.as_bytes(), "x", &ReadOptions::default()).unwrap();
+    assert_eq!(log.params.laser_time_increment, Some(9.765625e-5));
+    let g = log.scans.get(0).unwrap().geometry;
+    assert_eq!(g.time_increment, 9.765625e-5);
+    assert_eq!(g.ray_time_offset(2), 2.0 * 9.765625e-5);
+    assert_eq!(g.sweep_duration(), 2.0 * 9.765625e-5);
+    let mut out = Vec::new();
+    odocal_log::write_log(&mut out, &log).unwrap();
+    let again = read_carmen_from(out.as_slice(), "y", &ReadOptions::default()).unwrap();
+    assert_eq!(
+        again.scans.get(0).unwrap().geometry.time_increment,
+        9.765625e-5
+    );
+
+    let opts = ReadOptions {
+        time_increment: Some(2e-4),
+        ..ReadOptions::default()
+    };
+    let cli = read_carmen_from(text.as_bytes(), "x", &opts).unwrap();
+    assert_eq!(cli.scans.get(0).unwrap().geometry.time_increment, 2e-4);
+    let bad = "PARAM laser_front_laser_time_increment nan h 0\n";
+    let err = read_carmen_from(bad.as_bytes(), "x", &ReadOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("time between rays"), "{err}");
+}
