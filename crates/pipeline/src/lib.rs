@@ -19,6 +19,7 @@
 #![deny(missing_docs)]
 
 mod error;
+pub mod health;
 pub mod matching;
 pub mod output;
 pub mod parallel;
@@ -33,6 +34,7 @@ pub mod table_i;
 pub mod time_offset;
 
 pub use error::PipelineError;
+pub use health::{FaultKind, Finding, Severity};
 pub use odocal_solver::Trim;
 pub use output::{write_outputs, write_tuples};
 pub use progress::{NoProgress, Progress};
