@@ -79,13 +79,13 @@ fn slip_on_one_minute_logs_is_rejected() {
 }
 
 #[test]
-#[ignore = "Monte Carlo: 10 seeds of 60 s (≈ 15 s); run by .ci/run"]
+#[ignore = "Monte Carlo: 10 seeds of 60 s (≈ 4 s on 2 cores); run by .ci/run"]
 fn slip_on_one_minute_logs_ten_seeds() {
     check_seeds(60.0, 1..11);
 }
 
 #[test]
-#[ignore = "Monte Carlo: 10 seeds of 10 min (≈ 2 min); run by .ci/run"]
+#[ignore = "Monte Carlo: 10 seeds of 10 min (≈ 10 s on 2 cores, plus the simulation); run by .ci/run"]
 fn slip_on_ten_minute_logs_ten_seeds() {
     check_seeds(600.0, 1..11);
 }

@@ -15,10 +15,9 @@
 use odocal_pipeline::sync::TARGET_INTERVAL_S;
 use odocal_pipeline::table_i::{
     format_j_consistency, format_reproduction, format_summary, j_consistency, read_table_file,
-    read_tro_reference, reproduce_from_text, workspace_reference_dir, workspace_table_path,
-    JReading, PublishedRow, Reproduction, Tolerances,
+    read_tro_reference, reproduce_from_text, reproduction_options, workspace_reference_dir,
+    workspace_table_path, JReading, PublishedRow, Reproduction, Tolerances,
 };
-use odocal_pipeline::Options;
 use odocal_sim::{simulate, PresetRegistry};
 use odocal_solver::Params;
 use std::process::Command;
@@ -91,7 +90,7 @@ fn reproduce(row: &PublishedRow, samples: usize, seed: u64) -> Reproduction {
         .num_threads(2)
         .build()
         .expect("a thread pool");
-    pool.install(|| reproduce_from_text(row, samples, &text, &Options::default()))
+    pool.install(|| reproduce_from_text(row, samples, &text, &reproduction_options()))
         .unwrap_or_else(|e| panic!("row {}: the pipeline fails: {e}", row.name))
 }
 

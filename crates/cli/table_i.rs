@@ -12,7 +12,6 @@ use odocal_pipeline::table_i::{
     read_tro_reference, reproduce_from_text, workspace_reference_dir, workspace_table_path,
     JConsistency, PublishedRow, Reproduction, Tolerances,
 };
-use odocal_pipeline::Options;
 use odocal_sim::{simulate, PresetRegistry};
 use odocal_solver::Params;
 use std::fmt::Write as _;
@@ -164,7 +163,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let (rows, notes) = load_rows(&args)?;
     let pool = crate::input::thread_pool(args.threads)?;
     let tol = Tolerances::default();
-    let opts = Options::default();
+    let opts = odocal_pipeline::table_i::reproduction_options();
     let mut reproductions: Vec<Reproduction> = Vec::new();
     let mut timings = Vec::new();
     let started = Instant::now();

@@ -21,6 +21,7 @@
 
 #![deny(missing_docs)]
 
+pub mod atomic_file;
 mod error;
 pub mod estimate;
 pub mod health;
@@ -34,6 +35,7 @@ pub mod sync;
 pub mod table_i;
 pub mod time_offset;
 
+pub use atomic_file::{write_atomically, write_bytes_atomically};
 pub use error::PipelineError;
 pub use estimate::Estimate;
 pub use health::{FaultKind, Finding, Severity};

@@ -394,7 +394,7 @@ pub fn calibrate_log(
     let log: &Log = &log;
     let mut synced = synchronize_and_match(log, opts, progress, &mut timing)
         .map_err(|e| PipelineError::with_faults(e, &findings))?;
-    findings.extend(health::after_matching(log, &synced, opts));
+    findings.extend(health::clock_offset::quick_check(log, &synced, opts));
 
     let mut offset = None;
     if let Some(range) = opts.estimate_time_offset {
@@ -420,6 +420,8 @@ pub fn calibrate_log(
         timing.time_offset += t.elapsed().as_secs_f64();
         offset = Some(est);
     }
+    // Slip is judged at the offset finally used.
+    findings.extend(health::slip::episodes(log, &synced));
 
     let t_solve = Instant::now();
     let mut calibration =
@@ -483,7 +485,9 @@ fn edge_warning(
         first_line: None,
         time: None,
         message: format!(
-            "the estimated clock offset {estimate:+.3} s lies at the edge of the search range              ({start:+.2} ± {range:.2} s): the true offset may lie beyond it{hint}; widen the              search with `--time-offset-range {wider}`"
+            "the estimated clock offset {estimate:+.3} s lies at the edge of the search range \
+             ({start:+.2} ± {range:.2} s): the true offset may lie beyond it{hint}; widen the \
+             search with `--time-offset-range {wider}`"
         ),
     })
 }
