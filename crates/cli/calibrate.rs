@@ -3,7 +3,8 @@
 use crate::input::InputArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
-use odocal_pipeline::{build_report, calibrate_log, write_outputs, Options, Trim};
+use odocal_pipeline::{calibrate_log, Options, Trim};
+use odocal_report::{build_report, write_outputs};
 use odocal_solver::Params;
 use std::path::PathBuf;
 use std::time::Instant;

@@ -53,8 +53,8 @@
 //! (made-up numbers; `E_b`, `E_d`, `E_max` and the J columns optional).
 
 use crate::error::PipelineError;
+use crate::estimate::Estimate;
 use crate::progress::NoProgress;
-use crate::report::{build_report, Report};
 use crate::run::{calibrate_log, Options};
 use odocal_geom::{wrap_angle, Pose2};
 use odocal_log::{read_carmen_from, read_tuples, ReadOptions};
@@ -555,7 +555,7 @@ pub struct Reproduction {
     /// The number of samples asked of the simulation.
     pub target_samples: usize,
     /// The pipeline's result on the simulated log.
-    pub report: Report,
+    pub estimate: Estimate,
 }
 
 /// One quantity of a [`Reproduction`], compared.
@@ -621,7 +621,7 @@ impl Reproduction {
     /// Compares every quantity of [`QUANTITY_NAMES`] with the row.
     pub fn checks(&self, tol: &Tolerances) -> Vec<QuantityCheck> {
         let truth = self.truth;
-        let rep = &self.report;
+        let rep = &self.estimate;
         let recovered = Params::from_vector(rep.values());
         let mut published: Vec<f64> = truth.to_vector().to_vec();
         let tj = truth.j();
@@ -724,12 +724,11 @@ pub fn reproduce_from_text(
     let parse = t_read.elapsed().as_secs_f64();
     let mut outcome = calibrate_log(&log, opts, &NoProgress)?;
     outcome.timing.parse = parse;
-    let report = build_report(Path::new(&name), &log, opts, &outcome);
     Ok(Reproduction {
         row: row.clone(),
         truth: row.truth(),
         target_samples,
-        report,
+        estimate: Estimate::of(&outcome),
     })
 }
 
@@ -878,7 +877,7 @@ fn quantity_label(name: &str) -> &'static str {
 /// published σ), the recovered value ± reported σ, the error (also relative for
 /// lengths of the odometry and J), the error in σ, the bound and the verdict.
 pub fn format_reproduction(rep: &Reproduction, tol: &Tolerances) -> String {
-    let r = &rep.report;
+    let r = &rep.estimate;
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -945,7 +944,7 @@ pub fn format_summary(reps: &[Reproduction], tol: &Tolerances) -> String {
             rep.row.name,
             rep.row.samples,
             rep.target_samples,
-            rep.report.samples_used,
+            rep.estimate.samples_used,
             rep.worst_error_in_sigma(tol),
             if rep.bounds_apply(tol) {
                 "checked"
