@@ -7,7 +7,8 @@ mod common;
 
 use common::{cleanup, simulated_log, Truth};
 use odocal_log::{read_log, ReadOptions};
-use odocal_pipeline::{build_report, calibrate_log, NoProgress, Options, Report};
+use odocal_pipeline::{calibrate_log, NoProgress, Options};
+use odocal_report::{build_report, Report};
 
 const NAMES: [&str; 6] = ["r_L", "r_R", "b", "l_x", "l_y", "l_theta"];
 

@@ -3,7 +3,7 @@
 //!
 //! This binary is thin: each subcommand lives in its own module and calls the
 //! library crates (`odocal-log`, `odocal-icp`, `odocal-solver`, `odocal-sim`,
-//! `odocal-pipeline`).
+//! `odocal-pipeline`, `odocal-report`).
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -224,7 +224,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 fn timing_line(rep: &Reproduction, t: &RowTiming) -> String {
-    let s = &rep.report.timing_s;
+    let s = &rep.estimate.timing_s;
     format!(
         "time: simulate {:.2} s ({:.1} MB of log), read {:.2} s, sync {:.3} s, match {:.2} s, \
          solve {:.3} s",

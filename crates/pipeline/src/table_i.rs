@@ -40,8 +40,8 @@
 //! published standard deviations, same keys and units as `si`.
 
 use crate::error::PipelineError;
+use crate::estimate::Estimate;
 use crate::progress::NoProgress;
-use crate::report::{build_report, Report};
 use crate::run::{calibrate_log, Options};
 use odocal_geom::{wrap_angle, Pose2};
 use odocal_log::{read_carmen_from, read_tuples, ReadOptions};
@@ -407,7 +407,7 @@ pub struct Reproduction {
     /// The number of samples asked of the simulation.
     pub target_samples: usize,
     /// The pipeline's result on the simulated log.
-    pub report: Report,
+    pub estimate: Estimate,
 }
 
 /// One quantity of a [`Reproduction`], compared.
@@ -473,7 +473,7 @@ impl Reproduction {
     /// Compares every quantity of [`QUANTITY_NAMES`] with the row.
     pub fn checks(&self, tol: &Tolerances) -> Vec<QuantityCheck> {
         let truth = self.truth;
-        let rep = &self.report;
+        let rep = &self.estimate;
         let recovered = Params::from_vector(rep.values());
         let mut published: Vec<f64> = truth.to_vector().to_vec();
         let tj = truth.j();
@@ -576,12 +576,11 @@ pub fn reproduce_from_text(
     let parse = t_read.elapsed().as_secs_f64();
     let mut outcome = calibrate_log(&log, opts, &NoProgress)?;
     outcome.timing.parse = parse;
-    let report = build_report(Path::new(&name), &log, opts, &outcome);
     Ok(Reproduction {
         row: row.clone(),
         truth: row.truth(),
         target_samples,
-        report,
+        estimate: Estimate::of(&outcome),
     })
 }
 
@@ -692,7 +691,7 @@ fn quantity_label(name: &str) -> &'static str {
 /// published σ), the recovered value ± reported σ, the error (also relative for
 /// lengths of the odometry and J), the error in σ, the bound and the verdict.
 pub fn format_reproduction(rep: &Reproduction, tol: &Tolerances) -> String {
-    let r = &rep.report;
+    let r = &rep.estimate;
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -759,7 +758,7 @@ pub fn format_summary(reps: &[Reproduction], tol: &Tolerances) -> String {
             rep.row.name,
             rep.row.samples,
             rep.target_samples,
-            rep.report.samples_used,
+            rep.estimate.samples_used,
             rep.worst_error_in_sigma(tol),
             if rep.bounds_apply(tol) {
                 "checked"

@@ -1,9 +1,9 @@
 //! The report of a calibration: what `--json` prints and `results.json` holds, and
 //! the human summary.
 
-use crate::run::{Options, Outcome, Timing};
-use crate::sync::DiscardCounts;
 use odocal_log::Log;
+use odocal_pipeline::sync::DiscardCounts;
+use odocal_pipeline::{Estimate, Options, Outcome, Timing};
 use odocal_solver::{Observability, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
@@ -107,15 +107,8 @@ pub struct Settings {
 /// Builds the report of a finished calibration.
 pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -> Report {
     let c = &outcome.calibration;
-    let v = c.params.to_vector();
-    let sigma: [f64; 6] = std::array::from_fn(|i| c.covariance[i][i].max(0.0).sqrt());
-    let mut intervals: Vec<f64> = outcome.synced.samples.iter().map(|s| s.wheel.dt).collect();
-    let interval_s = if intervals.is_empty() {
-        f64::NAN
-    } else {
-        let mid = intervals.len() / 2;
-        *intervals.select_nth_unstable_by(mid, f64::total_cmp).1
-    };
+    let e = Estimate::of(outcome);
+    let v = e.params;
     Report {
         log: path.display().to_string(),
         log_contents: LogContents {
@@ -131,17 +124,17 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         l_x: v[3],
         l_y: v[4],
         l_theta: v[5],
-        sigma,
-        covariance: c.covariance,
-        j: c.j,
+        sigma: e.sigma,
+        covariance: e.covariance,
+        j: e.j,
         closed_form: c.closed_form.to_vector(),
-        samples_used: c.samples_used,
-        samples_synchronized: outcome.synced.samples.len(),
+        samples_used: e.samples_used,
+        samples_synchronized: e.samples_synchronized,
         samples_trimmed: outcome.synced.samples.len().saturating_sub(c.samples_used),
         scan_pairs: outcome.synced.pairs,
         discarded: outcome.synced.discarded.clone(),
-        stride: outcome.synced.stride,
-        interval_s,
+        stride: e.stride,
+        interval_s: e.interval_s,
         ticks_per_revolution: outcome.synced.ticks_per_revolution,
         sm_sigma: c.sm_sigma,
         cost_before: c.cost_before,
@@ -163,7 +156,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             second_pass: opts.second_pass,
             time_offset_s: opts.time_offset,
         },
-        timing_s: outcome.timing,
+        timing_s: e.timing_s,
     }
 }
 

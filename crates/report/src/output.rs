@@ -1,24 +1,13 @@
 //! Files written by `--out DIR`: results.json, samples.tuple and the SVG figures.
 
 use crate::report::Report;
-use crate::run::{Options, Outcome};
-use crate::samples::PairSample;
 use crate::svg::{histogram, plot, Figure, Series};
 use odocal_geom::Pose2;
-use odocal_log::write_tuple;
+use odocal_pipeline::{write_tuples, Options, Outcome};
 use odocal_solver::{Params, Predictor};
-use std::fs::{self, File};
-use std::io::{self, BufWriter, Write};
+use std::fs;
+use std::io;
 use std::path::Path;
-
-/// Writes the samples as tuples, one JSON object per line.
-pub fn write_tuples(path: &Path, samples: &[PairSample]) -> io::Result<()> {
-    let mut w = BufWriter::new(File::create(path)?);
-    for s in samples {
-        write_tuple(&mut w, &s.to_tuple())?;
-    }
-    w.flush()
-}
 
 /// Writes `results.json`, `samples.tuple` and, with `plots`, the figures into `dir`
 /// (created if needed).
