@@ -13,7 +13,11 @@ pub struct PartialArgs {
     pub fix: Vec<String>,
     /// Give a parameter a Gaussian prior: NAME=VALUE±SIGMA (or NAME=VALUE+-SIGMA;
     /// SI units). Repeatable.
-    #[arg(long = "prior", value_name = "NAME=VALUE±SIGMA", allow_hyphen_values = true)]
+    #[arg(
+        long = "prior",
+        value_name = "NAME=VALUE±SIGMA",
+        allow_hyphen_values = true
+    )]
     pub prior: Vec<String>,
     /// Print the numbers even when some parameters are weakly determined or not
     /// excited (their verdicts say so).

@@ -8,8 +8,8 @@ use anyhow::Context;
 use odocal_geom::Pose2;
 use odocal_log::{read_tuples, TupleRecord};
 use odocal_solver::{
-    calibrate, Calibration, Constraint, Constraints, ProfileSegment, Sample, SigmaEstimate, SolveOptions, Trim, Verdict,
-    PARAMETER_NAMES,
+    calibrate, Calibration, Constraint, Constraints, ProfileSegment, Sample, SigmaEstimate,
+    SolveOptions, Trim, Verdict, PARAMETER_NAMES,
 };
 use serde::Serialize;
 use std::path::PathBuf;
@@ -220,12 +220,7 @@ fn summary(args: &Args, cal: &Calibration, total: usize) -> String {
         let _ = writeln!(
             s,
             "  {:<8} = {:>13.8} {:<3} ± {:.2e}  {}{}",
-            PARAMETER_NAMES[i],
-            rep.value,
-            units[i],
-            rep.sigma,
-            status,
-            mark
+            PARAMETER_NAMES[i], rep.value, units[i], rep.sigma, status, mark
         );
     }
     let _ = writeln!(

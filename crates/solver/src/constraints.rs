@@ -50,9 +50,7 @@ impl Constraints {
 
     /// Whether any parameter has a prior.
     pub fn has_priors(&self) -> bool {
-        self.0
-            .iter()
-            .any(|c| matches!(c, Constraint::Prior { .. }))
+        self.0.iter().any(|c| matches!(c, Constraint::Prior { .. }))
     }
 
     /// The same constraints with every prior replaced by holding its mean (the
@@ -263,7 +261,10 @@ mod tests {
             parse_fix("x=1"),
             Err(ConstraintError::UnknownName(_))
         ));
-        assert!(matches!(parse_fix("b"), Err(ConstraintError::Syntax { .. })));
+        assert!(matches!(
+            parse_fix("b"),
+            Err(ConstraintError::Syntax { .. })
+        ));
         assert!(matches!(
             parse_fix("b=-0.1"),
             Err(ConstraintError::Value { .. })

@@ -46,7 +46,7 @@ pub(crate) fn step1_held(
         den += w * ap * ap;
         scale += w * (s.dphi_l * s.dphi_l + s.dphi_r * s.dphi_r) * (p[0] * p[0] + p[1] * p[1]);
     }
-    if !(den > 1e-12 * scale) {
+    if den.is_nan() || den <= 1e-12 * scale {
         return Err(step1_not_excited(samples, s1));
     }
     let z = num / den;
@@ -158,7 +158,7 @@ pub(crate) fn step2_held(
             at(0.5 * (a + b)).ok_or_else(not_excited)?
         }
     };
-    if !(x[0] > 0.0) {
+    if x[0].is_nan() || x[0] <= 0.0 {
         return Err(not_excited());
     }
     Ok(Step2 {

@@ -11,11 +11,11 @@ mod common;
 
 use common::{add_noise, exact_samples, make_sample, rng, Motion};
 use odocal_geom::Pose2;
-use rand::Rng;
 use odocal_solver::{
     calibrate, Constraint, Constraints, Params, Predictor, Sample, SolveError, SolveOptions, Trim,
     Verdict,
 };
+use rand::Rng;
 
 fn truth() -> Params {
     Params {
@@ -129,10 +129,7 @@ fn a_prior_combines_with_the_data_as_gaussian_information() {
     let moved = (cal.params.laser.y - free.params.laser.y) / (mean - free.params.laser.y);
     assert!((0.3..0.7).contains(&moved), "moved {moved}");
     // A very tight prior acts like holding the value.
-    c.0[4] = Constraint::Prior {
-        mean,
-        sigma: 1e-9,
-    };
+    c.0[4] = Constraint::Prior { mean, sigma: 1e-9 };
     let tight = calibrate(&samples, &options(c)).expect("solves");
     assert!((tight.params.laser.y - mean).abs() < 1e-8);
 }
@@ -164,13 +161,24 @@ fn refusal_suggests_fix_and_holding_makes_it_solvable() {
     let SolveError::NotExcited { sentence, .. } = &err else {
         panic!("unexpected {err:?}")
     };
-    assert!(sentence.contains("--fix") && sentence.contains("--prior"), "{sentence}");
+    assert!(
+        sentence.contains("--fix") && sentence.contains("--prior"),
+        "{sentence}"
+    );
     let t = truth().to_vector();
     // r_L, b, ℓx, ℓy known: r_R and ℓθ come from the straight runs.
     let c = held(0b011101, &t);
     let cal = calibrate(&samples, &options(c)).expect("solvable with held values");
-    assert!((cal.params.r_r / t[1] - 1.0).abs() < 3e-3, "{:?}", cal.params);
-    assert!((cal.params.laser.theta - t[5]).abs() < 2e-2, "{:?}", cal.params);
+    assert!(
+        (cal.params.r_r / t[1] - 1.0).abs() < 3e-3,
+        "{:?}",
+        cal.params
+    );
+    assert!(
+        (cal.params.laser.theta - t[5]).abs() < 2e-2,
+        "{:?}",
+        cal.params
+    );
     for i in [1, 5] {
         let z = (cal.params.to_vector()[i] - t[i]) / cal.covariance[i][i].sqrt();
         assert!(z.abs() < 4.0, "parameter {i}: {z}σ");
