@@ -16,14 +16,17 @@ use crate::error::SimError;
 use crate::kinematics::RobotParams;
 use crate::laser::LaserConfig;
 use crate::planner::TrajectoryKind;
+use crate::robot_classes;
 use crate::truth::TruthParams;
 use odocal_geom::Pose2;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 /// The built-in preset names.
-pub const BUILTIN_PRESETS: [&str; 7] = [
+pub const BUILTIN_PRESETS: [&str; 9] = [
     "khepera",
+    "turtlebot",
+    "pioneer",
     "khepera-displaced",
     "office",
     "corridor",
@@ -269,8 +272,11 @@ fn builtin(name: &str) -> Option<SimConfig> {
         "straight-only" => c.trajectory = TrajectoryKind::StraightOnly,
         "spin-only" => c.trajectory = TrajectoryKind::SpinOnly,
         "identical-turns" => c.trajectory = TrajectoryKind::IdenticalTurns,
+        "turtlebot" => return Some(robot_classes::turtlebot(c)),
+        "pioneer" => return Some(robot_classes::pioneer(c)),
         _ => return None,
     }
+    // The Khepera presets keep the instantaneous URG-04LX of the logs they reproduce.
     debug_assert_eq!(c.laser, LaserConfig::default());
     Some(c)
 }
