@@ -284,9 +284,9 @@ fn umbmark_section(table: &PublishedTable, reps: &[Reproduction]) -> String {
         if let Some(rep) = reps.iter().find(|r| r.row.name == name) {
             ours.push(OdometryLine {
                 name: format!("odocal on the {name} preset"),
-                b: rep.report.b,
-                r_l: rep.report.r_l,
-                r_r: rep.report.r_r,
+                b: rep.estimate.params[2],
+                r_l: rep.estimate.params[0],
+                r_r: rep.estimate.params[1],
             });
         }
     }
@@ -491,10 +491,10 @@ fn document(
         std::thread::available_parallelism().map_or(0, |n| n.get()),
         sum(&|_, t| t.simulate),
         sum(&|_, t| t.log_mb),
-        sum(&|r, _| r.report.timing_s.parse),
-        sum(&|r, _| r.report.timing_s.sync),
-        sum(&|r, _| r.report.timing_s.r#match),
-        sum(&|r, _| r.report.timing_s.solve),
+        sum(&|r, _| r.estimate.timing_s.parse),
+        sum(&|r, _| r.estimate.timing_s.sync),
+        sum(&|r, _| r.estimate.timing_s.r#match),
+        sum(&|r, _| r.estimate.timing_s.solve),
     );
     d
 }
