@@ -4,7 +4,7 @@
 use odocal_log::Log;
 use odocal_pipeline::sync::DiscardCounts;
 use odocal_pipeline::{Estimate, Options, Outcome, Timing};
-use odocal_solver::{Observability, PARAMETER_NAMES};
+use odocal_solver::{Constraint, Observability, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
 use std::path::Path;
@@ -16,6 +16,8 @@ pub struct Report {
     pub log: String,
     /// What the reader found in it.
     pub log_contents: LogContents,
+    /// The data-health findings: each fault found, what was done, what the user can do.
+    pub health: Vec<odocal_pipeline::Finding>,
     /// Left wheel radius (m).
     pub r_l: f64,
     /// Right wheel radius (m).
@@ -106,6 +108,11 @@ pub struct Settings {
     pub second_pass: bool,
     /// Clock offset applied when not estimated (s).
     pub time_offset_s: f64,
+    /// Per parameter (r_L, r_R, b, l_x, l_y, l_theta): "free", {"held": value}
+    /// (`--fix`) or {"prior": {"mean", "sigma"}} (`--prior`).
+    pub constraints: odocal_solver::Constraints,
+    /// Numbers returned even for weakly determined parameters (`--accept-weak`).
+    pub accept_weak: bool,
 }
 
 /// Builds the report of a finished calibration.
@@ -122,6 +129,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             first_skipped: log.stats.first_skipped.clone(),
             unknown_messages: log.stats.unknown.values().sum(),
         },
+        health: outcome.health.clone(),
         r_l: v[0],
         r_r: v[1],
         b: v[2],
@@ -166,6 +174,8 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             },
             second_pass: opts.second_pass,
             time_offset_s: opts.time_offset,
+            constraints: opts.solve.constraints,
+            accept_weak: opts.solve_options().accept_weak,
         },
         timing_s: e.timing_s,
     }
@@ -196,6 +206,9 @@ impl fmt::Display for Report {
                 lines.join(", ")
             )?;
         }
+        for finding in &self.health {
+            writeln!(f, "  {finding}")?;
+        }
         writeln!(f)?;
         let v = self.values();
         for i in 0..6 {
@@ -203,8 +216,14 @@ impl fmt::Display for Report {
                 .observability
                 .parameters
                 .get(i)
-                .map(|p| p.verdict.as_str())
-                .unwrap_or("");
+                .map(|p| match p.constraint {
+                    Constraint::Free => p.verdict.as_str().to_string(),
+                    Constraint::Held(_) => "held (--fix)".to_string(),
+                    Constraint::Prior { mean, sigma } => {
+                        format!("{} (prior {mean} ± {sigma})", p.verdict.as_str())
+                    }
+                })
+                .unwrap_or_default();
             if i == 5 {
                 writeln!(
                     f,
