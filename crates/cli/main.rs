@@ -3,7 +3,7 @@
 //!
 //! This binary is thin: each subcommand lives in its own module and calls the
 //! library crates (`odocal-log`, `odocal-icp`, `odocal-solver`, `odocal-sim`,
-//! `odocal-pipeline`).
+//! `odocal-pipeline`, `odocal-report`).
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -12,6 +12,7 @@ mod calibrate;
 mod info;
 mod input;
 mod matching;
+mod partial_args;
 mod progress_bar;
 mod read_args;
 mod simulate;

@@ -3,8 +3,10 @@
 
 use crate::matching::MatchStats;
 use crate::sync::{ScanPair, WheelMotion};
-use odocal_log::TupleRecord;
+use odocal_log::{write_tuple, TupleRecord};
 use odocal_solver::{ProfileSegment, Sample};
+use std::io;
+use std::path::Path;
 
 /// One scan pair that survived synchronization and matching.
 #[derive(Debug, Clone, PartialEq)]
@@ -96,4 +98,14 @@ pub fn wheel_only_sample(w: &WheelMotion) -> Sample {
                 .collect(),
         ),
     }
+}
+
+/// Writes the samples as tuples, one JSON object per line.
+pub fn write_tuples(path: &Path, samples: &[PairSample]) -> io::Result<()> {
+    crate::atomic_file::write_atomically(path, |w| {
+        for s in samples {
+            write_tuple(&mut *w, &s.to_tuple())?;
+        }
+        Ok(())
+    })
 }
