@@ -62,7 +62,8 @@ pub struct IcpResult {
     /// Range noise the two scans show themselves (the larger of the two; m), with a
     /// floor for exact data; see [`IcpParams::max_residual_to_noise`].
     pub noise_sigma: f64,
-    /// Share of the current scan's valid points used in the final step.
+    /// Correspondences used in the final step per valid point of the current scan on
+    /// a usable local line (at most 1).
     pub matched_share: f64,
     /// Starting points tried: 1 when the first guess led to the result.
     pub starts: u32,
@@ -344,7 +345,13 @@ impl Matcher {
                     iteration: iterations,
                 });
             }
-            let mut next = equations.solve(&estimate).ok_or(IcpError::Numerical {
+            // Tilt corrections that outweigh the information (many poor lines while
+            // far off): the step without them.
+            let mut next = match equations.solve(&estimate) {
+                Some(next) => Some(next),
+                None => self.plain_equations(tau_sq).solve(&estimate),
+            }
+            .ok_or(IcpError::Numerical {
                 iteration: iterations,
                 what: "singular or non-finite point-to-line step",
             })?;
@@ -500,11 +507,25 @@ impl Matcher {
             weakest_direction: unc.weakest_direction,
             residual_spread: robust_spread(&mut self.squared_residuals),
             noise_sigma: scans_noise(reference, current),
-            matched_share: used as f64 / current.valid_count().max(1) as f64,
+            matched_share: (used as f64 / current.lined_count.max(1) as f64).min(1.0),
             starts: 1,
         };
         check_consistency(&result, params)?;
         Ok(result)
+    }
+
+    /// The normal equations of the used correspondences without the
+    /// errors-in-variables correction.
+    fn plain_equations(&self, tau_sq: f64) -> NormalEquations {
+        let mut equations = NormalEquations::new();
+        for c in self
+            .correspondences
+            .iter()
+            .filter(|c| c.normalized_sq <= tau_sq)
+        {
+            equations.add(c.q, c.normal, c.offset, c.weight);
+        }
+        equations
     }
 
     /// Fills `self.correspondences` for the estimate.

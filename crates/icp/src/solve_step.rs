@@ -117,22 +117,22 @@ impl NormalEquations {
     }
 
     /// The pose minimising the cost; `previous` anchors unconstrained directions.
-    /// `None` when the rotation is undetermined or the result is not finite.
+    /// `None` when the translation block is not positive definite (e.g. tilt
+    /// corrections larger than the information: the caller then solves without
+    /// them), the rotation is undetermined or the result is not finite.
     pub fn solve(&self, previous: &Pose2) -> Option<Pose2> {
-        let h = &self.h;
+        let (h, g) = (&self.h, &self.g);
         let ridge = 1e-9 * (h[0][0] + h[1][1]) + f64::MIN_POSITIVE;
         // A (translation block, ridged), B (translation × rotation), C (rotation block).
         let a = [[h[0][0] + ridge, h[0][1]], [h[0][1], h[1][1] + ridge]];
         let b = [[h[0][2], h[0][3]], [h[1][2], h[1][3]]];
         let c = [[h[2][2], h[2][3]], [h[2][3], h[3][3]]];
-        let gt = [
-            self.g[0] + ridge * previous.x,
-            self.g[1] + ridge * previous.y,
-        ];
-        let gr = [self.g[2], self.g[3]];
+        let gt = [g[0] + ridge * previous.x, g[1] + ridge * previous.y];
+        let gr = [g[2], g[3]];
 
+        // A must be positive definite (a negative definite one has det > 0 too).
         let det = a[0][0] * a[1][1] - a[0][1] * a[0][1];
-        if det.is_nan() || det <= 0.0 {
+        if det.is_nan() || det <= 0.0 || a[0][0] <= 0.0 {
             return None;
         }
         let ai = [
@@ -292,6 +292,32 @@ mod tests {
             assert!((got.y - truth.y).abs() < 1e-8, "{got} vs {truth}");
             assert!(odocal_geom::wrap_angle(got.theta - truth.theta).abs() < 1e-9);
         }
+    }
+
+    /// Tilt corrections larger than the information itself make the translation
+    /// block negative definite (its determinant is positive): no solution, rather
+    /// than a maximum passed off as the minimum.
+    #[test]
+    fn overcorrected_equations_are_refused() {
+        let truth = Pose2::new(0.05, -0.02, 0.1);
+        let mut plain = NormalEquations::new();
+        let mut corrected = NormalEquations::new();
+        for i in 0..30 {
+            let q = [(i as f64 * 0.37).sin() * 2.0, (i as f64 * 0.91).cos() * 1.5];
+            let p = truth.transform_point(q);
+            let a = i as f64 * 1.3;
+            let n = [a.cos(), a.sin()];
+            let offset = n[0] * p[0] + n[1] * p[1];
+            plain.add(q, n, offset, 1.0);
+            corrected.add_corrected(q, n, offset, 1.0, 0.3, 5.0);
+        }
+        assert!(corrected.solve(&Pose2::IDENTITY).is_none());
+        let got = plain.solve(&Pose2::IDENTITY).expect("plain");
+        assert!(
+            (got.x - truth.x).abs() < 1e-9 && (got.y - truth.y).abs() < 1e-9,
+            "{got}"
+        );
+        assert!((got.theta - truth.theta).abs() < 1e-9, "{got}");
     }
 
     #[test]

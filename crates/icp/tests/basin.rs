@@ -22,8 +22,19 @@ fn check_basin(preset: &str, seconds: f64, seed: u64, every: usize, params: &Icp
 }
 
 fn check_run(run: &odocal_sim::SimRun, every: usize, params: &IcpParams, label: &str) {
+    check_run_gap(run, 4, every, params, label);
+}
+
+/// [`check_run`] with pairs `gap` scans apart.
+fn check_run_gap(
+    run: &odocal_sim::SimRun,
+    gap: usize,
+    every: usize,
+    params: &IcpParams,
+    label: &str,
+) {
     let scans = basin::prepare(run, params);
-    let pairs = basin::pairs(run, 4, every);
+    let pairs = basin::pairs(run, gap, every);
     let mut matcher = Matcher::new(params.clone());
     let from_truth = pairs
         .iter()
@@ -117,5 +128,23 @@ fn full_basin_grid_three_seeds() {
         for seed in 1..=3 {
             check_basin(preset, 60.0, seed, 8, &IcpParams::default());
         }
+    }
+}
+
+/// The TurtleBot-class (360° LDS, 5 Hz, σ 10 mm, pairs 2 scans = 0.4 s apart) and
+/// Pioneer-class (URG-04LX at 0.5 m/s, 4 scans apart) presets with the sweep turned
+/// off (their scans are compensated before matching in the pipeline).
+#[test]
+#[ignore = "about 15 s: the basin grid on the TurtleBot and Pioneer classes (.ci/run)"]
+fn robot_classes_converge_or_fail_from_far_guesses() {
+    for (preset, gap) in [("turtlebot", 2), ("pioneer", 4)] {
+        let mut config = odocal_sim::PresetRegistry::builtin()
+            .get(preset)
+            .expect("preset");
+        config.duration = 60.0;
+        config.seed = 1;
+        config.laser.time_increment = 0.0;
+        let run = odocal_sim::simulate(&config).expect("simulation");
+        check_run_gap(&run, gap, 8, &IcpParams::default(), preset);
     }
 }
