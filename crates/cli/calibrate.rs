@@ -4,7 +4,7 @@ use crate::input::InputArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
 use odocal_pipeline::{calibrate_log, Options, Trim};
-use odocal_report::{build_report, write_outputs};
+use odocal_report::{build_report, sha256_of_file, write_html, write_outputs, Provenance};
 use odocal_solver::Params;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -71,12 +71,15 @@ pub struct Args {
     /// Print the numbers even when some parameters are only weakly determined.
     #[arg(long)]
     pub accept_weak: bool,
-    /// Write results.json, samples.tuple (and figures with --plots) into DIR.
+    /// Write results.json, samples.tuple, results.html (and figures with --plots) into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// With --out: also write SVG figures.
+    /// With --out: also write each figure as an SVG file.
     #[arg(long, requires = "out")]
     pub plots: bool,
+    /// Write the one-page report (self-contained HTML: tables and figures) to FILE.
+    #[arg(long, value_name = "FILE.html")]
+    pub report: Option<PathBuf>,
     /// Print one JSON object instead of the human summary.
     #[arg(long)]
     pub json: bool,
@@ -99,6 +102,7 @@ fn nominal_params(v: &[f64]) -> anyhow::Result<Params> {
 
 /// Runs `odocal calibrate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let started = Instant::now();
     let input = &args.input;
     let pool = input.thread_pool()?;
     let t_parse = Instant::now();
@@ -125,8 +129,21 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let bar = Bar::for_stderr();
     let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
     outcome.timing.parse = parse_s;
-    let report = build_report(&input.read.log, &log, &opts, &outcome);
+    let mut report = build_report(&input.read.log, &log, &opts, &outcome);
+    let (input_sha256, input_bytes) = sha256_of_file(&input.read.log)
+        .with_context(|| format!("cannot read {} for its checksum", input.read.log.display()))?;
+    report.provenance = Some(Provenance {
+        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        input_sha256,
+        input_bytes,
+        wall_time_s: started.elapsed().as_secs_f64(),
+    });
 
+    if let Some(path) = &args.report {
+        write_html(path, &opts, &outcome, &report)
+            .with_context(|| format!("cannot write the report {}", path.display()))?;
+    }
     if let Some(dir) = &args.out {
         write_outputs(dir, &opts, &outcome, &report, args.plots)
             .with_context(|| format!("cannot write the results into {}", dir.display()))?;
@@ -137,6 +154,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         print!("{report}");
         if let Some(dir) = &args.out {
             println!("results written to {}", dir.display());
+        }
+        if let Some(path) = &args.report {
+            println!("report written to {}", path.display());
         }
     }
     Ok(())

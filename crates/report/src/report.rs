@@ -1,6 +1,8 @@
 //! The report of a calibration: what `--json` prints and `results.json` holds, and
 //! the human summary.
 
+use crate::finding::Finding;
+use crate::provenance::Provenance;
 use odocal_log::Log;
 use odocal_pipeline::sync::DiscardCounts;
 use odocal_pipeline::{Estimate, Options, Outcome, Timing};
@@ -63,6 +65,22 @@ pub struct Report {
     /// Estimated clock offset (s, laser clock minus encoder clock), when asked.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_s: Option<f64>,
+    /// The nominal parameters given (`--nominal`), order r_L, r_R, b, ℓx, ℓy, ℓθ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal: Option<[f64; 6]>,
+    /// With nominal values: `estimate / nominal` of r_L, r_R and b, what to multiply
+    /// the robot's configured values by.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correction_factors: Option<[f64; 3]>,
+    /// Data-health findings (faults found in the log, what was done about them).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub health: Vec<Finding>,
+    /// Consistency checks of the result (e.g. the two halves of the log agree).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub checks: Vec<Finding>,
+    /// Command line, version, input checksum and wall time, when the caller gives them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
     /// Trimming rule, refinement, profile use.
     pub settings: Settings,
     /// Wall time per stage (s).
@@ -141,6 +159,13 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         cost_after: c.cost_after,
         observability: c.observability.clone(),
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
+        nominal: opts.initial_params.map(|p| p.to_vector()),
+        correction_factors: opts
+            .initial_params
+            .map(|n| [v[0] / n.r_l, v[1] / n.r_r, v[2] / n.b]),
+        health: Vec::new(),
+        checks: Vec::new(),
+        provenance: None,
         settings: Settings {
             trim: opts.solve.trim,
             refine: opts.solve.refine,
@@ -267,6 +292,16 @@ impl fmt::Display for Report {
                 "  clock offset (laser clock − encoder clock): {:+.4} s",
                 t
             )?;
+        }
+        if let Some(c) = self.correction_factors {
+            writeln!(
+                f,
+                "  correction factors (calibrated / nominal): r_L ×{:.6}, r_R ×{:.6}, b ×{:.6}",
+                c[0], c[1], c[2]
+            )?;
+        }
+        for finding in self.health.iter().chain(&self.checks) {
+            writeln!(f, "  {finding}")?;
         }
         let t = &self.timing_s;
         writeln!(

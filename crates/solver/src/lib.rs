@@ -66,6 +66,7 @@ pub use covariance::INFORMATION_SINGULAR_RATIO;
 pub use error::SolveError;
 pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
+pub use observability::MOTION_CLASS_RATIO;
 pub use observability::{MotionContent, Observability, ParameterReport, Verdict};
 pub use params::{Params, PARAMETER_NAMES};
 pub use refine::Refinement;
