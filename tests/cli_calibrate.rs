@@ -4,19 +4,8 @@
 
 mod common;
 
-use common::{cleanup, simulated_log, temp_dir};
-use std::process::{Command, Output};
-
-fn odocal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_odocal"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{cleanup, odocal, simulated_log, stderr, temp_dir};
+use std::process::Output;
 
 /// One line on stderr starting with "error:", non-zero exit, no panic.
 fn assert_clean_failure(o: &Output) -> String {

@@ -1,6 +1,7 @@
 //! `odocal calibrate LOG`: raw log in, calibrated robot out.
 
 use crate::input::InputArgs;
+use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
 use odocal_pipeline::{calibrate_log, Options, Trim};
@@ -68,9 +69,8 @@ pub struct Args {
     /// Match the scans a second time, with first guesses from the first estimate.
     #[arg(long)]
     pub second_pass: bool,
-    /// Print the numbers even when some parameters are only weakly determined.
-    #[arg(long)]
-    pub accept_weak: bool,
+    #[command(flatten)]
+    pub partial: PartialArgs,
     /// Write results.json, samples.tuple, results.html (and figures with --plots) into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -120,11 +120,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         estimate_time_offset: args.estimate_time_offset.then_some(0.5),
         second_pass: args.second_pass,
         bootstrap_guesses: !args.identity_guess,
-        accept_weak: args.accept_weak,
+        accept_weak: args.partial.accept_weak,
         ..Options::default()
     };
     opts.solve.trim = args.trim.into();
     opts.solve.refine = !args.no_refine;
+    opts.solve.constraints = args.partial.constraints()?;
 
     let bar = Bar::for_stderr();
     let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;

@@ -3,12 +3,13 @@
 //! (the original package's `{T, phi_l, phi_r, sm}` stream, or ours with `sm_cov`
 //! and wheel-speed profiles).
 
+use crate::partial_args::PartialArgs;
 use anyhow::Context;
 use odocal_geom::Pose2;
 use odocal_log::{read_tuples, TupleRecord};
 use odocal_solver::{
-    calibrate, Calibration, ProfileSegment, Sample, SigmaEstimate, SolveOptions, Trim, Verdict,
-    PARAMETER_NAMES,
+    calibrate, Calibration, Constraint, Constraints, ProfileSegment, Sample, SigmaEstimate,
+    SolveOptions, Trim, Verdict, PARAMETER_NAMES,
 };
 use serde::Serialize;
 use std::path::PathBuf;
@@ -70,6 +71,8 @@ pub struct Args {
     /// `final` (final estimate and samples; tighter when outliers survive round 1).
     #[arg(long, value_enum, default_value = "first-round")]
     pub sigma: SigmaFrom,
+    #[command(flatten)]
+    pub partial: PartialArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -115,6 +118,9 @@ struct JsonOutput<'a> {
     cost_after: f64,
     reduced_chi2: f64,
     observability: &'a odocal_solver::Observability,
+    /// Per parameter (r_L, r_R, b, l_x, l_y, l_theta): "free", {"held": v} or
+    /// {"prior": {"mean", "sigma"}}.
+    constraints: Constraints,
 }
 
 /// Runs `odocal solve`.
@@ -129,6 +135,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             SigmaFrom::FirstRound => SigmaEstimate::FirstRound,
             SigmaFrom::Final => SigmaEstimate::FinalSet,
         },
+        constraints: args.partial.constraints()?,
+        accept_weak: args.partial.accept_weak,
         ..SolveOptions::default()
     };
     let cal = calibrate(&samples, &options)
@@ -156,6 +164,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             cost_after: cal.cost_after,
             reduced_chi2: cal.reduced_chi2,
             observability: &cal.observability,
+            constraints: options.constraints,
         };
         let mut text = serde_json::to_string_pretty(&out).context("serializing the result")?;
         text.push('\n');
@@ -197,19 +206,21 @@ fn summary(args: &Args, cal: &Calibration, total: usize) -> String {
     );
     let units = ["m", "m", "m", "m", "m", "rad"];
     for (i, rep) in cal.observability.parameters.iter().enumerate() {
-        let mark = match rep.verdict {
-            Verdict::WellDetermined => "",
-            Verdict::Weak | Verdict::NotExcited => "  <--",
+        let mark = match (rep.verdict, rep.constraint) {
+            (_, Constraint::Held(_)) | (Verdict::WellDetermined, _) => "",
+            (Verdict::Weak | Verdict::NotExcited, _) => "  <--",
+        };
+        let status = match rep.constraint {
+            Constraint::Free => rep.verdict.as_str().to_string(),
+            Constraint::Held(_) => "held (--fix)".to_string(),
+            Constraint::Prior { mean, sigma } => {
+                format!("{} (prior {mean} ± {sigma})", rep.verdict.as_str())
+            }
         };
         let _ = writeln!(
             s,
             "  {:<8} = {:>13.8} {:<3} ± {:.2e}  {}{}",
-            PARAMETER_NAMES[i],
-            rep.value,
-            units[i],
-            rep.sigma,
-            rep.verdict.as_str(),
-            mark
+            PARAMETER_NAMES[i], rep.value, units[i], rep.sigma, status, mark
         );
     }
     let _ = writeln!(

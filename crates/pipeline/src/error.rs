@@ -32,7 +32,9 @@ pub enum PipelineError {
     /// The solver returned numbers, but some parameters are so poorly determined
     /// (verdict "weak" or "not excited") that they would mislead.
     #[error(
-        "the data do not determine {} well enough: {sentence} (pass --accept-weak to see the numbers anyway)",
+        "the data do not determine {} well enough: {sentence} (if some of them are known, hold \
+         them with --fix NAME=VALUE or give a prior with --prior NAME=VALUE±SIGMA, SI units; \
+         pass --accept-weak to see the numbers anyway)",
         parameters.join(", ")
     )]
     NotDetermined {

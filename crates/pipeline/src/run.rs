@@ -51,9 +51,20 @@ pub struct Options {
     pub second_pass: bool,
     /// Scan matcher settings.
     pub icp: IcpParams,
-    /// Return numbers even when some parameters are only weakly determined (by
-    /// default that is an error naming them).
+    /// Return numbers even when some parameters are only weakly determined or not
+    /// excited (by default that is an error naming them), at every solve: the
+    /// first, the second pass, and each solve of the clock-offset search.
     pub accept_weak: bool,
+}
+
+impl Options {
+    /// The solver's settings with [`Options::accept_weak`] passed on.
+    pub fn solve_options(&self) -> SolveOptions {
+        SolveOptions {
+            accept_weak: self.accept_weak || self.solve.accept_weak,
+            ..self.solve
+        }
+    }
 }
 
 impl Default for Options {
@@ -248,7 +259,7 @@ pub fn synchronize_and_match(
             .collect();
         let rough = SolveOptions {
             refine: false,
-            ..opts.solve
+            ..opts.solve_options()
         };
         guess_params = odocal_solver::calibrate(&samples, &rough)
             .ok()
@@ -357,7 +368,8 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         .iter()
         .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
         .collect();
-    let calibration = odocal_solver::calibrate(&samples, &opts.solve)?;
+    let solve_options = opts.solve_options();
+    let calibration = odocal_solver::calibrate(&samples, &solve_options)?;
     let poor: Vec<String> = calibration
         .observability
         .parameters
@@ -365,7 +377,7 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         .filter(|p| p.verdict != Verdict::WellDetermined)
         .map(|p| p.name.clone())
         .collect();
-    if !poor.is_empty() && !opts.accept_weak {
+    if !poor.is_empty() && !solve_options.accept_weak {
         return Err(PipelineError::NotDetermined {
             parameters: poor,
             sentence: calibration.observability.sentence.clone(),

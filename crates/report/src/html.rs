@@ -34,7 +34,7 @@ const SHOWN: [&str; 14] = [
 ];
 
 /// Keys of the "Data and solution" section, in order.
-const DATA_KEYS: [&str; 19] = [
+const DATA_KEYS: [&str; 18] = [
     "log_contents",
     "samples_used",
     "samples_synchronized",
@@ -53,7 +53,6 @@ const DATA_KEYS: [&str; 19] = [
     "closed_form",
     "settings",
     "timing_s",
-    "constraints",
 ];
 
 /// A number with its origin: JSON pointer, unit scale and decimals.
@@ -148,13 +147,12 @@ fn words(key: &str) -> String {
 }
 
 /// What was given about parameter `i` (`--fix` / `--prior`), read from the results'
-/// `constraints` when present: `"free"`, `{"held": v}`, `{"prior": {mean, sigma}}`.
+/// `settings.constraints` (`--fix`, `--prior`): `"free"`, `{"held": v}`,
+/// `{"prior": {mean, sigma}}`.
 fn given(v: &Value, i: usize, scale: f64, digits: usize) -> Markup {
-    let c = &v["constraints"];
-    let c = c
-        .get(i)
-        .or_else(|| c.get(odocal_solver::PARAMETER_NAMES[i]));
-    let p = format!("/constraints/{i}");
+    let c = &v["settings"]["constraints"];
+    let c = c.get(i);
+    let p = format!("/settings/constraints/{i}");
     match c {
         Some(x) if x.get("held").is_some_and(Value::is_number) => html! {
             "held at " (num(&format!("{p}/held"), x["held"].as_f64().unwrap_or(f64::NAN), scale, digits))
@@ -177,7 +175,9 @@ fn given(v: &Value, i: usize, scale: f64, digits: usize) -> Markup {
 fn parameters(r: &Report, v: &Value) -> Markup {
     const KEYS: [&str; 6] = ["r_l", "r_r", "b", "l_x", "l_y", "l_theta"];
     let values = r.values();
-    let has_constraints = v.get("constraints").is_some();
+    let has_constraints = v["settings"]["constraints"]
+        .as_array()
+        .is_some_and(|a| a.iter().any(|c| c.as_str() != Some("free")));
     html! {
         table.params {
             tr {
@@ -248,7 +248,7 @@ pub fn page(report: &Report, figures: &[Figure]) -> String {
 
 /// The page, its numbers taken from `results` (the report as results.json holds it,
 /// possibly with fields the typed report does not know: they appear under "Further
-/// results", and `constraints` fills the parameters table's "given" column).
+/// results", and `settings.constraints` fills the parameters table's "given" column).
 pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -> String {
     let v = results;
     let r = report;

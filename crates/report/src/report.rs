@@ -6,7 +6,7 @@ use crate::provenance::Provenance;
 use odocal_log::Log;
 use odocal_pipeline::sync::DiscardCounts;
 use odocal_pipeline::{Estimate, Options, Outcome, Timing};
-use odocal_solver::{Observability, PARAMETER_NAMES};
+use odocal_solver::{Constraint, Observability, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
 use std::path::Path;
@@ -120,6 +120,11 @@ pub struct Settings {
     pub second_pass: bool,
     /// Clock offset applied when not estimated (s).
     pub time_offset_s: f64,
+    /// Per parameter (r_L, r_R, b, l_x, l_y, l_theta): "free", {"held": value}
+    /// (`--fix`) or {"prior": {"mean", "sigma"}} (`--prior`).
+    pub constraints: odocal_solver::Constraints,
+    /// Numbers returned even for weakly determined parameters (`--accept-weak`).
+    pub accept_weak: bool,
 }
 
 /// Builds the report of a finished calibration.
@@ -180,6 +185,8 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             },
             second_pass: opts.second_pass,
             time_offset_s: opts.time_offset,
+            constraints: opts.solve.constraints,
+            accept_weak: opts.solve_options().accept_weak,
         },
         timing_s: e.timing_s,
     }
@@ -217,8 +224,14 @@ impl fmt::Display for Report {
                 .observability
                 .parameters
                 .get(i)
-                .map(|p| p.verdict.as_str())
-                .unwrap_or("");
+                .map(|p| match p.constraint {
+                    Constraint::Free => p.verdict.as_str().to_string(),
+                    Constraint::Held(_) => "held (--fix)".to_string(),
+                    Constraint::Prior { mean, sigma } => {
+                        format!("{} (prior {mean} ± {sigma})", p.verdict.as_str())
+                    }
+                })
+                .unwrap_or_default();
             if i == 5 {
                 writeln!(
                     f,

@@ -127,7 +127,7 @@ fn page_has_every_section_and_figure_and_agrees_with_results_json() {
     });
     // Fields of later features: held and prior parameters, an unknown result.
     let mut results = serde_json::to_value(&report).unwrap();
-    results["constraints"] = json!(["free", "free", {"held": 0.089}, "free", {"prior": {"mean": 0.0, "sigma": 0.002}}, "free"]);
+    results["settings"]["constraints"] = json!(["free", "free", {"held": 0.089}, "free", {"prior": {"mean": 0.0, "sigma": 0.002}}, "free"]);
     results["consistency"] = json!({"max_difference_sigma": 1.25, "halves": 2});
 
     let figs = figures(&opts, &outcome, &report).expect("the figures draw");
@@ -185,8 +185,8 @@ fn page_has_every_section_and_figure_and_agrees_with_results_json() {
         "/j/1/1",
         "/nominal/2",
         "/correction_factors/0",
-        "/constraints/2/held",
-        "/constraints/4/prior/sigma",
+        "/settings/constraints/2/held",
+        "/settings/constraints/4/prior/sigma",
         "/consistency/max_difference_sigma",
         "/health/0/count",
         "/checks/0/count",

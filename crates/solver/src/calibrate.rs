@@ -1,18 +1,19 @@
 //! The whole chain: checks, closed form (step 1 + step 2) with outlier trimming,
 //! noise estimate, maximum-likelihood refinement, covariance, observability.
 
+use crate::constraints::Constraints;
 use crate::covariance::{invert_information, Inversion};
 use crate::error::SolveError;
 use crate::kinematics::{residual_of, Predictor, RawOdometry};
 use crate::noise::{residual_sigmas, NoiseWeights};
-use crate::normal_equations::accumulate;
 use crate::observability::{
     information_not_excited, null_direction_names, parameter_reports, sentence, step1_not_excited,
     step2_not_excited, wheel_signs, MotionContent, Observability, Verdict,
 };
 use crate::packed::Packed;
 use crate::params::Params;
-use crate::refine::{refine, Refinement};
+use crate::partial::{step1_held, step2_held};
+use crate::refine::{constrained_normal_equations, refine, Refinement};
 use crate::sample::Sample;
 use crate::step1::{step1, Step1};
 use crate::step2::{build_m, solve_m, Step2, A_SINGULAR_CONDITION};
@@ -42,6 +43,12 @@ pub struct SolveOptions {
     /// Which residuals the scan-matching σ's come from (default: as the original
     /// package, [`SigmaEstimate::FirstRound`]).
     pub sigma_from: SigmaEstimate,
+    /// Parameters held at known values or given priors (default: all free).
+    pub constraints: Constraints,
+    /// Return numbers even when the covariance says some parameters are not
+    /// excited (σ beyond the verdict's limit); by default that is an error. A
+    /// singular information matrix is an error regardless.
+    pub accept_weak: bool,
 }
 
 /// Which residuals `ŝ_pred − ŝ` the scan-matching standard deviations are estimated
@@ -66,6 +73,8 @@ impl Default for SolveOptions {
             use_profile: true,
             weighted_step1: true,
             sigma_from: SigmaEstimate::FirstRound,
+            constraints: Constraints::default(),
+            accept_weak: false,
         }
     }
 }
@@ -136,6 +145,7 @@ pub fn closed_form(samples: &[Sample], use_profile: bool) -> Result<ClosedForm, 
     closed_form_packed(
         &Packed::all(samples, use_profile),
         None,
+        &Constraints::default(),
         &mut Scratch::default(),
     )
 }
@@ -149,14 +159,18 @@ struct Scratch {
     residuals: Vec<[f64; 3]>,
 }
 
-/// Closed form on packed samples; leaves the residuals `ŝ_pred − ŝ` in
-/// `scratch.residuals`.
+/// Closed form on packed samples with the held parameters of `held` (priors are
+/// ignored here); leaves the residuals `ŝ_pred − ŝ` in `scratch.residuals`.
 fn closed_form_packed(
     samples: &[Packed],
     theta_weights: Option<&[f64]>,
+    held: &Constraints,
     scratch: &mut Scratch,
 ) -> Result<ClosedForm, SolveError> {
     let s1 = step1(samples, theta_weights);
+    if (0..6).any(|i| held.is_held(i)) {
+        return closed_form_held(samples, theta_weights, held, s1, scratch);
+    }
     if s1.condition.is_nan()
         || s1.condition > STEP1_SINGULAR_CONDITION
         || !s1.j21.is_finite()
@@ -197,6 +211,47 @@ fn closed_form_packed(
     })
 }
 
+/// The closed form with some parameters held (see [`crate::partial`]).
+fn closed_form_held(
+    samples: &[Packed],
+    theta_weights: Option<&[f64]>,
+    held: &Constraints,
+    s1: Step1,
+    scratch: &mut Scratch,
+) -> Result<ClosedForm, SolveError> {
+    let (j21, j22) = step1_held(samples, theta_weights, held, &s1)?;
+    let s2 = step2_held(samples, j21, j22, held, &s1, &mut scratch.unit)?;
+    let params = held.apply_held(&Params {
+        r_l: -s2.b * j21,
+        r_r: s2.b * j22,
+        b: s2.b,
+        laser: s2.laser,
+    });
+    let pred = Predictor::new(&params, true);
+    scratch.residuals.clear();
+    scratch.residuals.extend(
+        samples
+            .iter()
+            .map(|s| residual_of(pred.predict_pieces(s.pieces()), &s.sm)),
+    );
+    Ok(ClosedForm {
+        params,
+        step1: Step1 { j21, j22, ..s1 },
+        step2: s2,
+    })
+}
+
+/// The covariance with the rows and columns of held parameters set to zero.
+fn zero_held_rows(mut c: [[f64; 6]; 6], constraints: &Constraints) -> [[f64; 6]; 6] {
+    for i in (0..6).filter(|&i| constraints.is_held(i)) {
+        for j in 0..6 {
+            c[i][j] = 0.0;
+            c[j][i] = 0.0;
+        }
+    }
+    c
+}
+
 /// Calibrates: the six parameters, their covariance and the observability report.
 pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibration, SolveError> {
     for (k, s) in samples.iter().enumerate() {
@@ -224,7 +279,17 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     let mut active = Packed::all(samples, options.use_profile);
     let mut samples_per_round = vec![active.len()];
     let mut scratch = Scratch::default();
-    let mut cf = closed_form_packed(&active, tw, &mut scratch)?;
+    // Held parameters enter the closed form; priors only the refinement, unless the
+    // data alone do not determine the closed form: then it holds the priors' means.
+    let constraints = options.constraints;
+    let mut held = constraints;
+    let mut cf = match closed_form_packed(&active, tw, &held, &mut scratch) {
+        Err(SolveError::NotExcited { .. }) if constraints.has_priors() => {
+            held = constraints.priors_held();
+            closed_form_packed(&active, tw, &held, &mut scratch)?
+        }
+        other => other?,
+    };
     // Scan-matching noise as the original package estimates it: residuals of the
     // first (untrimmed) closed-form estimate over the samples kept after the first
     // trimming round (all samples when there is no trimming).
@@ -252,7 +317,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
                 stage: format!("after trimming round {}", round + 1),
             });
         }
-        cf = closed_form_packed(&active, tw, &mut scratch)?;
+        cf = closed_form_packed(&active, tw, &held, &mut scratch)?;
     }
     let sm_sigma = match options.sigma_from {
         SigmaEstimate::FirstRound => {
@@ -269,10 +334,10 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // The last pass of the refinement (or one pass at the closed form) gives the
     // cost and the Fisher information at the estimate.
     let (params, refinement, cost_before, cost_after, information) = if options.refine {
-        let (r, h) = refine(&active, &cf.params, &weights);
+        let (r, h) = refine(&active, &cf.params, &weights, &constraints);
         (r.params, Some(r), r.cost_before, r.cost_after, h)
     } else {
-        let ne = accumulate(&active, &cf.params, &weights);
+        let ne = constrained_normal_equations(&active, &cf.params, &weights, &constraints);
         (cf.params, None, ne.cost, ne.cost, ne.h)
     };
     if !params.to_vector().iter().all(|v| v.is_finite()) {
@@ -285,7 +350,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // the estimate is not trustworthy, with equal radii.
     let motion_equal_radii = || MotionContent::classify(&active, 1.0, 1.0);
     let covariance = match invert_information(&information) {
-        Inversion::Covariance(c) => *c,
+        Inversion::Covariance(c) => zero_held_rows(*c, &constraints),
         Inversion::Singular(null) => {
             return Err(information_not_excited(
                 null_direction_names(&null),
@@ -293,13 +358,13 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
             ))
         }
     };
-    let reports = parameter_reports(&params, &covariance);
+    let reports = parameter_reports(&params, &covariance, &constraints);
     let not_excited: Vec<String> = reports
         .iter()
         .filter(|r| r.verdict == Verdict::NotExcited)
         .map(|r| r.name.clone())
         .collect();
-    if !not_excited.is_empty() {
+    if !not_excited.is_empty() && !options.accept_weak {
         return Err(information_not_excited(not_excited, &motion_equal_radii()));
     }
     let motion = MotionContent::classify(&active, params.r_l, params.r_r);
