@@ -187,20 +187,21 @@ fn parameters(r: &Report, v: &Value) -> Markup {
             }
             @for i in 0..6 {
                 @let (scale, digits, unit) = if i == 5 { (180.0 / std::f64::consts::PI, 4, "°") } else { (1e3, 4, "mm") };
-                @let verdict = r.observability.parameters.get(i).map(|p| p.verdict.as_str()).unwrap_or("");
+                @let held = v["settings"]["constraints"][i].get("held").is_some();
+                @let verdict = if held { "held (--fix)" } else { r.observability.parameters.get(i).map(|p| p.verdict.as_str()).unwrap_or("") };
                 tr {
                     th { (PARAMETER_LABELS[i]) }
                     td { (num(&format!("/{}", KEYS[i]), values[i], scale, digits)) }
                     td { "± " (num(&format!("/sigma/{i}"), r.sigma[i], scale, digits)) }
                     td { (unit) }
-                    td { span class=(format!("verdict {}", verdict.replace(' ', "-"))) { (verdict) } }
+                    td { span class=(format!("verdict {}", verdict.split(" (").next().unwrap_or("").replace(' ', "-"))) { (verdict) } }
                     @if let Some(n) = r.nominal {
                         td { (num(&format!("/nominal/{i}"), n[i], scale, digits)) }
                         td { @if let Some(c) = r.correction_factors.filter(|_| i < 3) {
                             "× " (num(&format!("/correction_factors/{i}"), c[i], 1.0, 6))
                         } @else { "—" } }
                     }
-                    @if has_constraints { td { (given(v, i, scale, digits)) } }
+                    @if has_constraints { td.given { (given(v, i, scale, digits)) } }
                 }
             }
         }

@@ -198,7 +198,7 @@ fn page_has_every_section_and_figure_and_agrees_with_results_json() {
         assert!(pointers.iter().any(|q| q == p), "{p} is not on the page");
     }
     let text: String = doc.root_element().text().collect();
-    assert!(text.contains("held at") && text.contains("prior"));
+    assert!(text.contains("held at") && text.contains("prior") && text.contains("held (--fix)"));
     assert!(text.contains("rotation of scan matching and odometry disagree"));
     assert!(text.contains(&"ab".repeat(32)));
     // The slip span is shaded in the residuals over time, and named in the legend.
