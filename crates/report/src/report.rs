@@ -65,6 +65,10 @@ pub struct Report {
     /// Estimated clock offset (s, laser clock minus encoder clock), when asked.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_s: Option<f64>,
+    /// Duration of one laser sweep (s), when the rays were taken one after another and
+    /// the sweep was compensated before matching.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep_compensated_s: Option<f64>,
     /// Trimming rule, refinement, profile use.
     pub settings: Settings,
     /// Wall time per stage (s).
@@ -149,6 +153,13 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         cost_after: c.cost_after,
         observability: c.observability.clone(),
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
+        sweep_compensated_s: outcome.synced.sweep_compensated.then(|| {
+            log.scans
+                .geometries
+                .iter()
+                .map(|g| g.sweep_duration().abs())
+                .fold(0.0, f64::max)
+        }),
         settings: Settings {
             trim: opts.solve.trim,
             refine: opts.solve.refine,
@@ -279,6 +290,13 @@ impl fmt::Display for Report {
         )?;
         if let Some(w) = &o.wheel_signs {
             writeln!(f, "  warning: {w}")?;
+        }
+        if let Some(t) = self.sweep_compensated_s {
+            writeln!(
+                f,
+                "  sweep: {:.1} ms per scan, compensated (rays moved to mid-sweep with the wheel motion)",
+                t * 1e3
+            )?;
         }
         if let Some(t) = self.time_offset_s {
             writeln!(
