@@ -15,11 +15,10 @@
 use odocal_pipeline::sync::TARGET_INTERVAL_S;
 use odocal_pipeline::table_i::{
     format_j_consistency, format_reproduction, format_summary, j_consistency, read_table,
-    read_table_file, read_tro_reference, reproduce_from_text, row_seed, umbmark_j_consistency,
-    workspace_reference_dir, workspace_table_path, JReading, PublishedRow, Reproduction,
-    Tolerances,
+    read_table_file, read_tro_reference, reproduce_from_text, reproduction_options, row_seed,
+    umbmark_j_consistency, workspace_reference_dir, workspace_table_path, JReading, PublishedRow,
+    Reproduction, Tolerances,
 };
-use odocal_pipeline::Options;
 use odocal_sim::{simulate_table_row, RobotParams, SECONDS_PER_SAMPLE};
 use odocal_solver::Params;
 use std::process::Command;
@@ -73,7 +72,7 @@ fn reproduce(row: &PublishedRow, samples: usize, seed: u64) -> Reproduction {
         .num_threads(2)
         .build()
         .expect("a thread pool");
-    pool.install(|| reproduce_from_text(row, samples, &text, &Options::default()))
+    pool.install(|| reproduce_from_text(row, samples, &text, &reproduction_options()))
         .unwrap_or_else(|e| panic!("row {}: the pipeline fails: {e}", row.name))
 }
 

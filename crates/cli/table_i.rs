@@ -12,7 +12,6 @@ use odocal_pipeline::table_i::{
     workspace_reference_dir, workspace_table_path, JConsistency, OdometryLine, PublishedRow,
     PublishedTable, Reproduction, Tolerances,
 };
-use odocal_pipeline::Options;
 use odocal_sim::{simulate_table_row, RobotParams};
 use odocal_solver::Params;
 use std::fmt::Write as _;
@@ -169,7 +168,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let Loaded { rows, table, notes } = load_rows(&args)?;
     let pool = crate::input::thread_pool(args.threads)?;
     let tol = Tolerances::default();
-    let opts = Options::default();
+    let opts = odocal_pipeline::table_i::reproduction_options();
     let mut reproductions: Vec<Reproduction> = Vec::new();
     let mut timings = Vec::new();
     let started = Instant::now();

@@ -13,27 +13,34 @@
 //! ```
 //!
 //! Stages, one module each: [`sync`] (encoder interpolation at the scan timestamps,
-//! encoder profile, discards by reason), [`matching`] (ICP over the pairs, in parallel
-//! with [`parallel`]), [`time_offset`] (optional clock-offset search), [`run`] (the
+//! encoder profile, discards by reason), [`sweep`] (rays of a sweeping laser moved to
+//! the sensor frame at the scan's reference time), [`matching`] (ICP over the pairs, in
+//! parallel with [`parallel`]), [`health`] (data faults found, repaired and named,
+//! before and after matching), [`time_offset`] (optional clock-offset search), [`run`] (the
 //! whole, with timing), [`samples`] (the samples and their tuples), [`estimate`] (the
 //! core numbers of a result).
 
 #![deny(missing_docs)]
 
+pub mod atomic_file;
 mod error;
 pub mod estimate;
+pub mod health;
 pub mod matching;
 pub mod parallel;
 mod progress;
 pub mod run;
 pub mod samples;
+pub mod sweep;
 pub mod sync;
 /// Regression against published calibration results (ICRA 2008 Table I, T-RO 2013).
 pub mod table_i;
 pub mod time_offset;
 
+pub use atomic_file::{write_atomically, write_bytes_atomically};
 pub use error::PipelineError;
 pub use estimate::Estimate;
+pub use health::{FaultKind, Finding, Severity};
 pub use odocal_solver::Trim;
 pub use progress::{NoProgress, Progress};
 pub use run::{calibrate_log, synchronize_and_match, Options, Outcome, Synchronized, Timing};

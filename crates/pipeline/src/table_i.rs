@@ -708,6 +708,14 @@ impl Reproduction {
     }
 }
 
+/// The pipeline options of the reproduction: the defaults with the original
+/// package's T-RO trimming rule, as the published results were computed.
+pub fn reproduction_options() -> Options {
+    let mut opts = Options::default();
+    opts.solve.trim = odocal_solver::Trim::TRO;
+    opts
+}
+
 /// Runs the whole pipeline (read → synchronize → match → solve) on the text of a
 /// Carmen log simulated with `row`'s parameters ([`PublishedRow::truth`]) and
 /// returns the comparison material. `target_samples` is the number of samples the

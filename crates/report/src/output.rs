@@ -4,7 +4,7 @@
 use crate::figures::{figures, Figure};
 use crate::html::page;
 use crate::report::Report;
-use odocal_pipeline::{write_tuples, Options, Outcome};
+use odocal_pipeline::{write_bytes_atomically, write_tuples, Options, Outcome};
 use std::fs;
 use std::io;
 use std::path::Path;
@@ -27,11 +27,12 @@ pub fn write_html(
     outcome: &Outcome,
     report: &Report,
 ) -> io::Result<()> {
-    fs::write(path, html_report(opts, outcome, report)?)
+    write_bytes_atomically(path, html_report(opts, outcome, report)?.as_bytes())
 }
 
 /// Writes `results.json`, `samples.tuple`, `results.html` and, with `plots`, the
-/// figures as `NAME.svg` into `dir` (created if needed).
+/// figures as `NAME.svg` into `dir` (created if needed); each file atomically (a
+/// temporary file renamed).
 pub fn write_outputs(
     dir: &Path,
     opts: &Options,
@@ -41,13 +42,13 @@ pub fn write_outputs(
 ) -> io::Result<()> {
     fs::create_dir_all(dir)?;
     let json = serde_json::to_string_pretty(report).map_err(io::Error::other)?;
-    fs::write(dir.join("results.json"), json + "\n")?;
+    write_bytes_atomically(&dir.join("results.json"), (json + "\n").as_bytes())?;
     write_tuples(&dir.join("samples.tuple"), &outcome.synced.samples)?;
     let figs = drawn(opts, outcome, report)?;
-    fs::write(dir.join("results.html"), page(report, &figs))?;
+    write_bytes_atomically(&dir.join("results.html"), page(report, &figs).as_bytes())?;
     if plots {
         for f in &figs {
-            fs::write(dir.join(format!("{}.svg", f.name)), &f.svg)?;
+            write_bytes_atomically(&dir.join(format!("{}.svg", f.name)), f.svg.as_bytes())?;
         }
     }
     Ok(())

@@ -18,6 +18,8 @@ pub struct Report {
     pub log: String,
     /// What the reader found in it.
     pub log_contents: LogContents,
+    /// The data-health findings: each fault found, what was done, what the user can do.
+    pub health: Vec<odocal_pipeline::Finding>,
     /// Left wheel radius (m).
     pub r_l: f64,
     /// Right wheel radius (m).
@@ -72,15 +74,16 @@ pub struct Report {
     /// the robot's configured values by.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub correction_factors: Option<[f64; 3]>,
-    /// Data-health findings (faults found in the log, what was done about them).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub health: Vec<Finding>,
     /// Consistency checks of the result (e.g. the two halves of the log agree).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub checks: Vec<Finding>,
     /// Command line, version, input checksum and wall time, when the caller gives them.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub provenance: Option<Provenance>,
+    /// Duration of one laser sweep (s), when the rays were taken one after another and
+    /// the sweep was compensated before matching.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep_compensated_s: Option<f64>,
     /// Trimming rule, refinement, profile use.
     pub settings: Settings,
     /// Wall time per stage (s).
@@ -141,6 +144,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             first_skipped: log.stats.first_skipped.clone(),
             unknown_messages: log.stats.unknown.values().sum(),
         },
+        health: outcome.health.clone(),
         r_l: v[0],
         r_r: v[1],
         b: v[2],
@@ -168,9 +172,15 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         correction_factors: opts
             .initial_params
             .map(|n| [v[0] / n.r_l, v[1] / n.r_r, v[2] / n.b]),
-        health: Vec::new(),
         checks: Vec::new(),
         provenance: None,
+        sweep_compensated_s: outcome.synced.sweep_compensated.then(|| {
+            log.scans
+                .geometries
+                .iter()
+                .map(|g| g.sweep_duration().abs())
+                .fold(0.0, f64::max)
+        }),
         settings: Settings {
             trim: opts.solve.trim,
             refine: opts.solve.refine,
@@ -216,6 +226,9 @@ impl fmt::Display for Report {
                 c.skipped_lines,
                 lines.join(", ")
             )?;
+        }
+        for finding in &self.health {
+            writeln!(f, "  {finding}")?;
         }
         writeln!(f)?;
         let v = self.values();
@@ -299,6 +312,13 @@ impl fmt::Display for Report {
         if let Some(w) = &o.wheel_signs {
             writeln!(f, "  warning: {w}")?;
         }
+        if let Some(t) = self.sweep_compensated_s {
+            writeln!(
+                f,
+                "  sweep: {:.1} ms per scan, compensated (rays moved to mid-sweep with the wheel motion)",
+                t * 1e3
+            )?;
+        }
         if let Some(t) = self.time_offset_s {
             writeln!(
                 f,
@@ -313,7 +333,7 @@ impl fmt::Display for Report {
                 c[0], c[1], c[2]
             )?;
         }
-        for finding in self.health.iter().chain(&self.checks) {
+        for finding in &self.checks {
             writeln!(f, "  {finding}")?;
         }
         let t = &self.timing_s;

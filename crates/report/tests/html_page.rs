@@ -100,13 +100,12 @@ fn numbers_agree(doc: &Html, results: &Value) -> Vec<String> {
 fn page_has_every_section_and_figure_and_agrees_with_results_json() {
     let (opts, outcome, mut report) = calibrated();
     let t0 = outcome.synced.samples[0].pair.t0;
-    report.health.push(Finding {
-        kind: "slip".into(),
-        severity: Severity::Warning,
+    report.health.push(odocal_pipeline::Finding {
+        kind: odocal_pipeline::FaultKind::Slip,
+        severity: odocal_pipeline::Severity::Warning,
         count: 1,
         first_line: Some(1234),
         time: Some(t0 + 10.0),
-        spans: vec![[t0 + 10.0, t0 + 12.5]],
         message: "rotation of scan matching and odometry disagree for 2.5 s".into(),
     });
     report.checks.push(Finding {
@@ -115,7 +114,7 @@ fn page_has_every_section_and_figure_and_agrees_with_results_json() {
         count: 6,
         first_line: None,
         time: None,
-        spans: Vec::new(),
+        spans: vec![[t0 + 10.0, t0 + 12.5]],
         message: "the two halves agree within 2σ".into(),
     });
     report.provenance = Some(Provenance {
@@ -201,7 +200,7 @@ fn page_has_every_section_and_figure_and_agrees_with_results_json() {
     assert!(text.contains("held at") && text.contains("prior") && text.contains("held (--fix)"));
     assert!(text.contains("rotation of scan matching and odometry disagree"));
     assert!(text.contains(&"ab".repeat(32)));
-    // The slip span is shaded in the residuals over time, and named in the legend.
+    // A finding's span is shaded in the residuals over time, and named in the legend.
     assert!(text.contains("flagged span (slip)"));
 }
 

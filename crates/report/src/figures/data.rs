@@ -3,7 +3,9 @@
 
 use crate::report::Report;
 use odocal_geom::Pose2;
+use odocal_pipeline::health::slip::flagged;
 use odocal_pipeline::samples::PairSample;
+use odocal_pipeline::FaultKind;
 use odocal_pipeline::{Options, Outcome};
 use odocal_solver::{Params, Predictor, Sample};
 
@@ -46,6 +48,22 @@ pub fn nominal_params(estimate: &Params) -> Params {
     }
 }
 
+/// The time spans (s since `t0`) of the runs of consecutive flagged samples.
+fn slip_spans(pairs: &[PairSample], flagged: &[usize], t0: f64) -> Vec<(f64, f64, String)> {
+    let mut out: Vec<(f64, f64, String)> = Vec::new();
+    let mut last: Option<usize> = None;
+    for &k in flagged {
+        let Some(p) = pairs.get(k) else { continue };
+        let (a, b) = (p.pair.t0 - t0, p.pair.t1 - t0);
+        match (last, out.last_mut()) {
+            (Some(l), Some(span)) if k == l + 1 => span.1 = b,
+            _ => out.push((a, b, "slip".into())),
+        }
+        last = Some(k);
+    }
+    out
+}
+
 impl<'a> FigureData<'a> {
     /// Prepares the figures' material.
     pub fn new(opts: &Options, outcome: &'a Outcome, report: &Report) -> FigureData<'a> {
@@ -69,16 +87,18 @@ impl<'a> FigureData<'a> {
                 "odometry, equal radii, laser at origin",
             ),
         };
-        let spans = report
-            .health
+        let mut spans: Vec<(f64, f64, String)> = report
+            .checks
             .iter()
-            .chain(&report.checks)
             .flat_map(|f| {
                 f.spans
                     .iter()
                     .map(|s| (s[0] - t0, s[1] - t0, f.kind.clone()))
             })
             .collect();
+        if report.health.iter().any(|f| f.kind == FaultKind::Slip) {
+            spans.extend(slip_spans(pairs, &flagged(&outcome.synced), t0));
+        }
         FigureData {
             pairs,
             samples,
