@@ -24,6 +24,7 @@ mod read;
 mod summary;
 mod tokens;
 mod tuple;
+mod wheel_angles;
 mod writer;
 
 pub use carmen::read_carmen_from;
@@ -34,4 +35,8 @@ pub use options::{Mode, ReadOptions};
 pub use read::{detect_format, read_log, LogFormat};
 pub use summary::{GeometrySummary, LogSummary, SkippedLine};
 pub use tuple::{read_tuples, read_tuples_from, write_tuple, TupleRecord};
+pub use wheel_angles::{
+    encoders_from_odometry, ticks_of_angle, wheel_rotations, NominalWheels,
+    WHEEL_TICKS_PER_REVOLUTION,
+};
 pub use writer::{write_log, LogWriter, RobotLaserPoses};
