@@ -20,6 +20,7 @@
 
 #![deny(missing_docs)]
 
+pub mod consistency;
 mod error;
 pub mod estimate;
 pub mod matching;

@@ -2,9 +2,10 @@
 //! the human summary.
 
 use odocal_log::Log;
+use odocal_pipeline::consistency::Consistency;
 use odocal_pipeline::sync::DiscardCounts;
 use odocal_pipeline::{Estimate, Options, Outcome, Timing};
-use odocal_solver::{Constraint, Observability, PARAMETER_NAMES};
+use odocal_solver::{Constraint, Observability, SharedScanNoise, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
 use std::path::Path;
@@ -60,6 +61,11 @@ pub struct Report {
     pub cost_after: f64,
     /// Observability verdicts.
     pub observability: Observability,
+    /// The two halves of the samples calibrated separately and compared.
+    pub consistency: Consistency,
+    /// The noise shared by consecutive samples (through their common scan) that the
+    /// covariance accounts for; absent when the samples were treated as independent.
+    pub shared_scan_noise: Option<SharedScanNoise>,
     /// Estimated clock offset (s, laser clock minus encoder clock), when asked.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_s: Option<f64>,
@@ -145,6 +151,8 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         cost_before: c.cost_before,
         cost_after: c.cost_after,
         observability: c.observability.clone(),
+        consistency: outcome.consistency.clone(),
+        shared_scan_noise: c.shared_scan_noise,
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
         settings: Settings {
             trim: opts.solve.trim,
@@ -260,6 +268,17 @@ impl fmt::Display for Report {
             self.sm_sigma[1] * 1e3,
             self.sm_sigma[2].to_degrees()
         )?;
+        if let Some(n) = &self.shared_scan_noise {
+            writeln!(
+                f,
+                "  shared by consecutive samples through their common scan: {:.0} %, {:.0} %, {:.0} % \
+                 of it (x, y, θ; {} shared scans), accounted for in the σ above",
+                100.0 * n.shared_fraction[0],
+                100.0 * n.shared_fraction[1],
+                100.0 * n.shared_fraction[2],
+                n.shared_scans
+            )?;
+        }
         writeln!(
             f,
             "  cost: {:.4e} (closed form) → {:.4e}",
@@ -273,6 +292,13 @@ impl fmt::Display for Report {
         )?;
         if let Some(w) = &o.wheel_signs {
             writeln!(f, "  warning: {w}")?;
+        }
+        match &self.consistency {
+            Consistency::Checked(h) if h.agree => writeln!(f, "  consistency: {}", h.sentence)?,
+            Consistency::Checked(h) => writeln!(f, "  warning: {}", h.sentence)?,
+            Consistency::NotAvailable { reason } => {
+                writeln!(f, "  consistency: not checked ({reason})")?
+            }
         }
         if let Some(t) = self.time_offset_s {
             writeln!(
