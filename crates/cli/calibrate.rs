@@ -10,9 +10,12 @@ use odocal_solver::Params;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// The outlier-trimming rule, as named on the command line.
+/// The outlier-trimming rule, as named on the command line (`calibrate` and `solve`).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TrimArg {
+    /// χ² on the residuals whitened by their robust scale, iterated (the default;
+    /// works at any sample count).
+    Chi2,
     /// ICRA 2008: drop the worst 5 %, three times.
     Icra,
     /// The original package (T-RO 2013): p = 1 %, 4 rounds, xy or θ threshold.
@@ -21,9 +24,22 @@ pub enum TrimArg {
     None,
 }
 
+impl TrimArg {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            TrimArg::Chi2 => "chi2",
+            TrimArg::Icra => "icra",
+            TrimArg::Tro => "tro",
+            TrimArg::None => "none",
+        }
+    }
+}
+
 impl From<TrimArg> for Trim {
     fn from(t: TrimArg) -> Trim {
         match t {
+            TrimArg::Chi2 => Trim::CHI2,
             TrimArg::Icra => Trim::ICRA,
             TrimArg::Tro => Trim::TRO,
             TrimArg::None => Trim::None,
@@ -37,7 +53,7 @@ pub struct Args {
     #[command(flatten)]
     pub input: InputArgs,
     /// Outlier trimming rule.
-    #[arg(long, value_enum, default_value = "tro")]
+    #[arg(long, value_enum, default_value = "chi2")]
     pub trim: TrimArg,
     /// Skip the maximum-likelihood refinement (closed form only).
     #[arg(long)]
@@ -49,9 +65,13 @@ pub struct Args {
     /// estimated from the residuals, which is what the reported σ assume).
     #[arg(long)]
     pub icp_covariance: bool,
-    /// Estimate a constant clock offset between laser and encoders (within ±0.5 s).
+    /// Estimate a constant clock offset between laser and encoders (within
+    /// ±0.5 s of --time-offset, or ±--time-offset-range), before observability is judged.
     #[arg(long)]
     pub estimate_time_offset: bool,
+    /// Half-width (s) of the clock-offset search; implies --estimate-time-offset.
+    #[arg(long, value_name = "S")]
+    pub time_offset_range: Option<f64>,
     /// Nominal parameters "r_L,r_R,b" or "r_L,r_R,b,l_x,l_y,l_theta" (m, rad): first
     /// guesses for scan matching come from odometry with them, and the figures
     /// compare them with the calibrated ones.
@@ -113,7 +133,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         use_profile: !args.constant_speed,
         use_icp_covariance: args.icp_covariance,
         time_offset: input.time_offset,
-        estimate_time_offset: args.estimate_time_offset.then_some(0.5),
+        estimate_time_offset: (args.estimate_time_offset || args.time_offset_range.is_some())
+            .then_some(args.time_offset_range.unwrap_or(0.5)),
         second_pass: args.second_pass,
         bootstrap_guesses: !args.identity_guess,
         accept_weak: args.partial.accept_weak,
@@ -128,17 +149,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     outcome.timing.parse = parse_s;
     let report = build_report(&input.read.log, &log, &opts, &outcome);
 
-    if let Some(dir) = &args.out {
+    // The results are printed whatever happens to --out, so they are never lost.
+    let written = args.out.as_ref().map(|dir| {
         write_outputs(dir, &opts, &outcome, &report, args.plots)
-            .with_context(|| format!("cannot write the results into {}", dir.display()))?;
-    }
+            .with_context(|| format!("cannot write the results into {}", dir.display()))
+    });
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         print!("{report}");
-        if let Some(dir) = &args.out {
-            println!("results written to {}", dir.display());
+    }
+    match (written, &args.out) {
+        (Some(Err(e)), _) => return Err(e.context("the results above were printed only")),
+        (Some(Ok(())), Some(dir)) if !args.json => {
+            println!("results written to {}", dir.display())
         }
+        _ => {}
     }
     Ok(())
 }

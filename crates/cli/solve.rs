@@ -1,8 +1,9 @@
-//! `odocal solve TUPLES [--trim icra|tro|none] [--no-refine] [--json]`: the six
+//! `odocal solve TUPLES [--trim chi2|icra|tro|none] [--icp-covariance] [--no-refine] [--json]`: the six
 //! parameters, their covariance and the observability report from a tuple file
 //! (the original package's `{T, phi_l, phi_r, sm}` stream, or ours with `sm_cov`
 //! and wheel-speed profiles).
 
+use crate::calibrate::TrimArg;
 use crate::partial_args::PartialArgs;
 use anyhow::Context;
 use odocal_geom::Pose2;
@@ -13,35 +14,6 @@ use odocal_solver::{
 };
 use serde::Serialize;
 use std::path::PathBuf;
-
-/// Outlier-trimming rule of the command line.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TrimRule {
-    /// ICRA 2008: drop the worst 5 % three times.
-    Icra,
-    /// Original package (T-RO 2013): p = 1 %, 4 rounds, drop above either threshold.
-    Tro,
-    /// Keep every sample.
-    None,
-}
-
-impl TrimRule {
-    fn name(self) -> &'static str {
-        match self {
-            TrimRule::Icra => "icra",
-            TrimRule::Tro => "tro",
-            TrimRule::None => "none",
-        }
-    }
-
-    fn to_trim(self) -> Trim {
-        match self {
-            TrimRule::Icra => Trim::ICRA,
-            TrimRule::Tro => Trim::TRO,
-            TrimRule::None => Trim::None,
-        }
-    }
-}
 
 /// Where the scan-matching σ's are estimated (command line).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,9 +29,15 @@ pub enum SigmaFrom {
 pub struct Args {
     /// Tuple file: a stream of JSON objects {"T", "phi_l", "phi_r", "sm"[, "sm_cov", "profile"]}.
     pub tuples: PathBuf,
-    /// Outlier trimming between closed-form solves.
-    #[arg(long, value_enum, default_value = "tro")]
-    pub trim: TrimRule,
+    /// Outlier trimming between closed-form solves (the same rules and default as
+    /// `calibrate`).
+    #[arg(long, value_enum, default_value = "chi2")]
+    pub trim: TrimArg,
+    /// Weight each sample by its `sm_cov` (the scan matcher's covariance of ŝ) when
+    /// every sample has one. Off by default, as in `calibrate` (`--icp-covariance`
+    /// there), so the two give the same numbers on the same samples.
+    #[arg(long)]
+    pub icp_covariance: bool,
     /// Return the closed form without maximum-likelihood refinement.
     #[arg(long)]
     pub no_refine: bool,
@@ -127,9 +105,18 @@ struct JsonOutput<'a> {
 /// Runs `odocal solve`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let records = read_tuples(&args.tuples)?;
-    let samples: Vec<Sample> = records.iter().map(sample_from_record).collect();
+    let samples: Vec<Sample> = records
+        .iter()
+        .map(|r| {
+            let s = sample_from_record(r);
+            Sample {
+                sm_cov: s.sm_cov.filter(|_| args.icp_covariance),
+                ..s
+            }
+        })
+        .collect();
     let options = SolveOptions {
-        trim: args.trim.to_trim(),
+        trim: args.trim.into(),
         refine: !args.no_refine,
         use_profile: !args.no_profile,
         sigma_from: match args.sigma {

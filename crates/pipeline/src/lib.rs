@@ -14,15 +14,18 @@
 //!
 //! Stages, one module each: [`sync`] (encoder interpolation at the scan timestamps,
 //! encoder profile, discards by reason), [`matching`] (ICP over the pairs, in parallel
-//! with [`parallel`]), [`time_offset`] (optional clock-offset search), [`run`] (the
+//! with [`parallel`]), [`health`] (data faults found, repaired and named, before and
+//! after matching), [`time_offset`] (optional clock-offset search), [`run`] (the
 //! whole, with timing), [`samples`] (the samples and their tuples), [`estimate`] (the
 //! core numbers of a result).
 
 #![deny(missing_docs)]
 
+pub mod atomic_file;
 pub mod consistency;
 mod error;
 pub mod estimate;
+pub mod health;
 pub mod matching;
 pub mod parallel;
 mod progress;
@@ -33,8 +36,10 @@ pub mod sync;
 pub mod table_i;
 pub mod time_offset;
 
+pub use atomic_file::{write_atomically, write_bytes_atomically};
 pub use error::PipelineError;
 pub use estimate::Estimate;
+pub use health::{FaultKind, Finding, Severity};
 pub use odocal_solver::Trim;
 pub use progress::{NoProgress, Progress};
 pub use run::{calibrate_log, synchronize_and_match, Options, Outcome, Synchronized, Timing};

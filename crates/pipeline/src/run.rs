@@ -2,6 +2,7 @@
 
 use crate::consistency::{check_halves, Consistency};
 use crate::error::PipelineError;
+use crate::health::{self, FaultKind, Finding, Severity};
 use crate::matching::{match_pairs, MatchStats};
 use crate::progress::Progress;
 use crate::samples::PairSample;
@@ -125,6 +126,8 @@ pub struct Synchronized {
 /// The result of [`calibrate_log`].
 #[derive(Debug, Clone)]
 pub struct Outcome {
+    /// What the data-health stage found (and did), in the order found.
+    pub health: Vec<Finding>,
     /// Samples and discards.
     pub synced: Synchronized,
     /// The solver's output.
@@ -391,26 +394,22 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
 
 /// Runs the pipeline on a log already in memory. Scan matching runs on rayon's
 /// current thread pool (wrap the call in `ThreadPool::install` to choose the count).
+///
+/// Order: the data-health stage (repairs, findings), synchronization and matching,
+/// the checks on the samples (clock offset, slip), the clock-offset estimate when
+/// asked, then the solve and its observability verdicts — so that the verdicts are
+/// those of the data at the estimated offset. A refusal names the data faults found.
 pub fn calibrate_log(
     log: &Log,
     opts: &Options,
     progress: &dyn Progress,
 ) -> Result<Outcome, PipelineError> {
     let mut timing = Timing::default();
-    let mut synced = synchronize_and_match(log, opts, progress, &mut timing)?;
-
-    let t_solve = Instant::now();
-    let mut calibration = solve(&synced, opts)?;
-    timing.solve += t_solve.elapsed().as_secs_f64();
-
-    if opts.second_pass {
-        let t = Instant::now();
-        second_pass(log, &mut synced, &calibration.params, opts, progress);
-        timing.r#match += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        calibration = solve(&synced, opts)?;
-        timing.solve += t.elapsed().as_secs_f64();
-    }
+    let (log, mut findings) = health::check_log(log, opts);
+    let log: &Log = &log;
+    let mut synced = synchronize_and_match(log, opts, progress, &mut timing)
+        .map_err(|e| PipelineError::with_faults(e, &findings))?;
+    findings.extend(health::clock_offset::quick_check(log, &synced, opts));
 
     let mut offset = None;
     if let Some(range) = opts.estimate_time_offset {
@@ -419,14 +418,38 @@ pub fn calibrate_log(
                 "the clock-offset search range must be positive, got {range} s"
             )));
         }
+        // Estimate first, on an estimate not yet judged: the verdicts come after.
         let t = Instant::now();
-        let est = estimate_time_offset(log, &synced, opts, opts.time_offset, range, &calibration)?;
+        let lenient = Options {
+            accept_weak: true,
+            ..opts.clone()
+        };
+        let base =
+            solve(&synced, &lenient).map_err(|e| PipelineError::with_faults(e, &findings))?;
+        timing.solve += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let start = opts.time_offset;
+        let est = estimate_time_offset(log, &synced, opts, start, range, &base)?;
+        findings.extend(edge_warning(log, &synced, start, range, est.offset));
         resynchronize(log, &mut synced, est.offset);
         timing.time_offset += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        calibration = solve(&synced, opts)?;
-        timing.solve += t.elapsed().as_secs_f64();
         offset = Some(est);
+    }
+    // Slip is judged at the offset finally used.
+    findings.extend(health::slip::episodes(log, &synced));
+
+    let t_solve = Instant::now();
+    let mut calibration =
+        solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
+    timing.solve += t_solve.elapsed().as_secs_f64();
+
+    if opts.second_pass {
+        let t = Instant::now();
+        second_pass(log, &mut synced, &calibration.params, opts, progress);
+        timing.r#match += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        calibration = solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
+        timing.solve += t.elapsed().as_secs_f64();
     }
 
     let t = Instant::now();
@@ -439,10 +462,57 @@ pub fn calibrate_log(
     timing.solve += t.elapsed().as_secs_f64();
 
     Ok(Outcome {
+        health: findings,
         synced,
         calibration,
         offset,
         timing,
         consistency,
+    })
+}
+
+/// A warning when the estimated offset lies at the edge of the search range: the true
+/// offset may lie beyond it.
+fn edge_warning(
+    log: &Log,
+    synced: &Synchronized,
+    start: f64,
+    range: f64,
+    estimate: f64,
+) -> Option<Finding> {
+    let step = range / ((range / crate::time_offset::GRID_STEP_S).round().max(5.0));
+    if (estimate - start).abs() < range - 1.5 * step {
+        return None;
+    }
+    let quick = health::clock_offset::quick_estimate(
+        log,
+        synced,
+        start,
+        health::clock_offset::QUICK_RANGE_S.max(2.0 * range),
+    );
+    let wider = match quick {
+        Some(q) if health::clock_offset::is_large(&q, start) => {
+            health::clock_offset::suggested_range(q.offset - start).max(2.0 * range)
+        }
+        _ => 2.0 * range,
+    };
+    let hint = match quick {
+        Some(q) => format!(
+            "; the quick check puts it near {:+.2} s (correlation {:.3})",
+            q.offset, q.correlation
+        ),
+        None => String::new(),
+    };
+    Some(Finding {
+        kind: FaultKind::ClockOffset,
+        severity: Severity::Warning,
+        count: 1,
+        first_line: None,
+        time: None,
+        message: format!(
+            "the estimated clock offset {estimate:+.3} s lies at the edge of the search range \
+             ({start:+.2} ± {range:.2} s): the true offset may lie beyond it{hint}; widen the \
+             search with `--time-offset-range {wider}`"
+        ),
     })
 }

@@ -5,8 +5,7 @@ use crate::matching::MatchStats;
 use crate::sync::{ScanPair, WheelMotion};
 use odocal_log::{write_tuple, TupleRecord};
 use odocal_solver::{ProfileSegment, Sample};
-use std::fs::File;
-use std::io::{self, BufWriter, Write};
+use std::io;
 use std::path::Path;
 
 /// One scan pair that survived synchronization and matching.
@@ -105,9 +104,10 @@ pub fn wheel_only_sample(w: &WheelMotion) -> Sample {
 
 /// Writes the samples as tuples, one JSON object per line.
 pub fn write_tuples(path: &Path, samples: &[PairSample]) -> io::Result<()> {
-    let mut w = BufWriter::new(File::create(path)?);
-    for s in samples {
-        write_tuple(&mut w, &s.to_tuple())?;
-    }
-    w.flush()
+    crate::atomic_file::write_atomically(path, |w| {
+        for s in samples {
+            write_tuple(&mut *w, &s.to_tuple())?;
+        }
+        Ok(())
+    })
 }

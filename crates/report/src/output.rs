@@ -3,14 +3,14 @@
 use crate::report::Report;
 use crate::svg::{histogram, plot, Figure, Series};
 use odocal_geom::Pose2;
-use odocal_pipeline::{write_tuples, Options, Outcome};
+use odocal_pipeline::{write_bytes_atomically, write_tuples, Options, Outcome};
 use odocal_solver::{Params, Predictor};
 use std::fs;
 use std::io;
 use std::path::Path;
 
 /// Writes `results.json`, `samples.tuple` and, with `plots`, the figures into `dir`
-/// (created if needed).
+/// (created if needed); each file atomically (a temporary file renamed).
 pub fn write_outputs(
     dir: &Path,
     opts: &Options,
@@ -20,11 +20,11 @@ pub fn write_outputs(
 ) -> io::Result<()> {
     fs::create_dir_all(dir)?;
     let json = serde_json::to_string_pretty(report).map_err(io::Error::other)?;
-    fs::write(dir.join("results.json"), json + "\n")?;
+    write_bytes_atomically(&dir.join("results.json"), (json + "\n").as_bytes())?;
     write_tuples(&dir.join("samples.tuple"), &outcome.synced.samples)?;
     if plots {
         for (name, svg) in figures(opts, outcome) {
-            fs::write(dir.join(name), svg)?;
+            write_bytes_atomically(&dir.join(name), svg.as_bytes())?;
         }
     }
     Ok(())

@@ -17,6 +17,8 @@ pub struct Report {
     pub log: String,
     /// What the reader found in it.
     pub log_contents: LogContents,
+    /// The data-health findings: each fault found, what was done, what the user can do.
+    pub health: Vec<odocal_pipeline::Finding>,
     /// Left wheel radius (m).
     pub r_l: f64,
     /// Right wheel radius (m).
@@ -129,6 +131,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             first_skipped: log.stats.first_skipped.clone(),
             unknown_messages: log.stats.unknown.values().sum(),
         },
+        health: outcome.health.clone(),
         r_l: v[0],
         r_r: v[1],
         b: v[2],
@@ -199,6 +202,9 @@ impl fmt::Display for Report {
                 c.skipped_lines,
                 lines.join(", ")
             )?;
+        }
+        for finding in &self.health {
+            writeln!(f, "  {finding}")?;
         }
         writeln!(f)?;
         let v = self.values();

@@ -60,7 +60,10 @@ pub use laser::LaserConfig;
 pub use laser_models::LASER_MODELS;
 pub use output::LogSummary;
 pub use planner::{MotionLimits, Planner, TrajectoryKind, TRAJECTORY_NAMES};
-pub use presets::{PresetRegistry, TableRow, BUILTIN_PRESETS};
+pub use presets::{
+    simulate_table_row, table_row_config, PresetRegistry, TableRow, BUILTIN_PRESETS,
+    SECONDS_PER_SAMPLE,
+};
 pub use simulation::{simulate, simulate_in, SimEncoderRecord, SimRun, SimScan};
 pub use truth::{GroundTruth, TruthFaults, TruthParams, TruthScan, TruthSlip, TRUTH_FORMAT};
 pub use world::{Segment, World};

@@ -33,8 +33,9 @@ pub const STEP1_SINGULAR_CONDITION: f64 = 1e12;
 /// Settings of [`calibrate`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SolveOptions {
-    /// Outlier trimming between closed-form solves (default: the original
-    /// package's rule, [`Trim::TRO`]).
+    /// Outlier trimming between closed-form solves (default: χ² on the residuals
+    /// whitened by their robust scale, [`Trim::CHI2`], which works at any sample
+    /// count; [`Trim::TRO`] is the original package's rule).
     pub trim: Trim,
     /// Refine all six parameters by maximum likelihood (default true).
     pub refine: bool,
@@ -70,7 +71,7 @@ pub enum SigmaEstimate {
 impl Default for SolveOptions {
     fn default() -> Self {
         SolveOptions {
-            trim: Trim::TRO,
+            trim: Trim::CHI2,
             refine: true,
             use_profile: true,
             weighted_step1: true,
@@ -217,6 +218,15 @@ fn closed_form_packed(
     })
 }
 
+/// Residuals `ŝ_pred − ŝ` of packed samples at `params`.
+fn residuals_at(samples: &[Packed], params: &Params) -> Vec<[f64; 3]> {
+    let pred = Predictor::new(params, true);
+    samples
+        .iter()
+        .map(|s| residual_of(pred.predict_pieces(s.pieces()), &s.sm))
+        .collect()
+}
+
 /// The closed form with some parameters held (see [`crate::partial`]).
 fn closed_form_held(
     samples: &[Packed],
@@ -320,12 +330,23 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // first (untrimmed) closed-form estimate over the samples kept after the first
     // trimming round (all samples when there is no trimming).
     let mut noise_residuals: Option<Vec<[f64; 3]>> = None;
+    // Rules that judge every sample at the current estimate (samples may come back)
+    // stop when the kept set no longer changes; the others drop from the active set.
+    let whole = options.trim.judges_all_samples();
+    let all = if whole { active.clone() } else { Vec::new() };
+    let mut previous = vec![true; all.len()];
     for round in 0..options.trim.rounds() {
-        let keep = options.trim.keep(&scratch.residuals);
+        let at_estimate;
+        let residuals: &[[f64; 3]] = if whole {
+            at_estimate = residuals_at(&all, &cf.params);
+            &at_estimate
+        } else {
+            &scratch.residuals
+        };
+        let keep = options.trim.keep(residuals);
         if round == 0 {
             noise_residuals = Some(
-                scratch
-                    .residuals
+                residuals
                     .iter()
                     .zip(&keep)
                     .filter(|(_, &k)| k)
@@ -333,8 +354,21 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
                     .collect(),
             );
         }
-        let mut kept = keep.iter();
-        active.retain(|_| kept.next().copied().unwrap_or(false));
+        if whole {
+            if keep == previous {
+                break;
+            }
+            active = all
+                .iter()
+                .zip(&keep)
+                .filter(|(_, &k)| k)
+                .map(|(p, _)| *p)
+                .collect();
+            previous = keep;
+        } else {
+            let mut kept = keep.iter();
+            active.retain(|_| kept.next().copied().unwrap_or(false));
+        }
         samples_per_round.push(active.len());
         if active.len() < MIN_SAMPLES {
             return Err(SolveError::TooFewSamples {
