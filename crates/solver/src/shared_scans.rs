@@ -27,7 +27,7 @@ use crate::packed::Packed;
 use crate::params::Params;
 use nalgebra::{Matrix3, SMatrix, Vector3};
 use serde::Serialize;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 type Matrix6x3 = SMatrix<f64, 6, 3>;
 type Matrix6 = SMatrix<f64, 6, 6>;
@@ -130,7 +130,8 @@ pub(crate) fn score_covariance(
     let n = nearest_psd(&(total / samples.len() as f64));
 
     let mut m = Matrix6::zeros();
-    let mut per_scan: HashMap<u64, Matrix6x3> = HashMap::new();
+    // Ordered by time, so that the sums (and the covariance) are reproducible.
+    let mut per_scan: BTreeMap<u64, Matrix6x3> = BTreeMap::new();
     for ((s, gk), t) in samples.iter().zip(&g).zip(&times) {
         let gw = gk.transpose() * weight(weights, s.index);
         m += gw * n * gw.transpose();
