@@ -2,6 +2,8 @@
 
 #![allow(dead_code)]
 
+pub mod accuracy;
+
 use odocal_sim::{simulate, SimConfig};
 use std::fs::File;
 use std::io::BufWriter;

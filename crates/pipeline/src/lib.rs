@@ -13,9 +13,10 @@
 //! ```
 //!
 //! Stages, one module each: [`sync`] (encoder interpolation at the scan timestamps,
-//! encoder profile, discards by reason), [`matching`] (ICP over the pairs, in parallel
-//! with [`parallel`]), [`health`] (data faults found, repaired and named, before and
-//! after matching), [`time_offset`] (optional clock-offset search), [`run`] (the
+//! encoder profile, discards by reason), [`sweep`] (rays of a sweeping laser moved to
+//! the sensor frame at the scan's reference time), [`matching`] (ICP over the pairs, in
+//! parallel with [`parallel`]), [`health`] (data faults found, repaired and named,
+//! before and after matching), [`time_offset`] (optional clock-offset search), [`run`] (the
 //! whole, with timing), [`samples`] (the samples and their tuples), [`estimate`] (the
 //! core numbers of a result).
 
@@ -31,6 +32,7 @@ pub mod parallel;
 mod progress;
 pub mod run;
 pub mod samples;
+pub mod sweep;
 pub mod sync;
 /// Regression against published calibration results (ICRA 2008 Table I, T-RO 2013).
 pub mod table_i;

@@ -6,6 +6,7 @@ use crate::health::{self, FaultKind, Finding, Severity};
 use crate::matching::{match_pairs, MatchStats};
 use crate::progress::Progress;
 use crate::samples::PairSample;
+use crate::sweep::{compensated_pairs, has_sweep, reference_time};
 use crate::sync::{
     default_stride, scan_pairs, DiscardCounts, DiscardReason, EncoderTrack, ScanPair, SyncLimits,
     WheelMotion,
@@ -13,12 +14,14 @@ use crate::sync::{
 use crate::time_offset::{estimate_time_offset, OffsetEstimate};
 use odocal_geom::Pose2;
 use odocal_icp::IcpParams;
-use odocal_log::Log;
+use odocal_log::{Log, ScanStore};
 use odocal_solver::{Calibration, Params, Predictor, SolveOptions, Verdict};
+use std::borrow::Cow;
 use std::time::Instant;
 
 /// Pairs matched with identity first guesses to bootstrap the odometry guesses of
-/// the others (only when there are at least twice as many pairs).
+/// the others when there are at least twice as many pairs (with fewer, all pairs are
+/// matched from identity first, and the failures again from odometry).
 pub const BOOTSTRAP_PAIRS: usize = 300;
 
 /// Fewest samples the pipeline hands to the solver.
@@ -45,9 +48,10 @@ pub struct Options {
     pub estimate_time_offset: Option<f64>,
     /// Parameters for the first guesses of scan matching (odometry prediction).
     pub initial_params: Option<Params>,
-    /// Without `initial_params`: match [`BOOTSTRAP_PAIRS`] evenly spread pairs with
-    /// identity guesses, solve roughly, and guess the other pairs by odometry with
-    /// that estimate (fewer ICP iterations and failures). Off: identity for all.
+    /// Without `initial_params`: match [`BOOTSTRAP_PAIRS`] evenly spread pairs (all
+    /// pairs of a shorter log) with identity guesses, solve roughly, and guess the
+    /// other pairs and the failed ones by odometry with that estimate (fewer ICP
+    /// iterations and failures). Off: identity for all.
     pub bootstrap_guesses: bool,
     /// Match again with first guesses predicted from the first estimate.
     pub second_pass: bool,
@@ -121,6 +125,9 @@ pub struct Synchronized {
     pub discarded: DiscardCounts,
     /// Clock offset used (s): laser clock minus encoder clock.
     pub time_offset: f64,
+    /// The scans were swept and the samples were matched after moving every ray to
+    /// the sensor frame at its scan's reference time (see [`crate::sweep`]).
+    pub sweep_compensated: bool,
 }
 
 /// The result of [`calibrate_log`].
@@ -203,7 +210,15 @@ pub fn synchronize_and_match(
 ) -> Result<Synchronized, PipelineError> {
     let ticks = ticks_per_revolution(log, opts)?;
     let t_sync = Instant::now();
-    let scan_times: Vec<f64> = log.scans.scans.iter().map(|s| s.t).collect();
+    // Each scan stands for its reference time (the timestamp without a sweep).
+    let scan_times: Vec<f64> = (0..log.scans.len())
+        .map(|i| {
+            log.scans
+                .get(i)
+                .map_or(log.scans.scans[i].t, |s| reference_time(&s))
+        })
+        .collect();
+    let sweep = has_sweep(&log.scans);
     let stride = match opts.stride {
         Some(0) => {
             return Err(PipelineError::InvalidSetting(
@@ -240,11 +255,18 @@ pub fn synchronize_and_match(
     progress.start("matching", index_pairs.len());
     let mut matched: Vec<Option<Result<MatchStats, String>>> = vec![None; kept.len()];
     let mut guess_params = opts.initial_params;
-    if guess_params.is_none() && opts.bootstrap_guesses && kept.len() >= 2 * BOOTSTRAP_PAIRS {
-        // Match an evenly spread subset with identity guesses, solve roughly, and
-        // guess the rest by odometry with that estimate.
-        let every = kept.len() / BOOTSTRAP_PAIRS;
-        let subset: Vec<usize> = (0..kept.len()).step_by(every).collect();
+    let bootstrap = (opts.bootstrap_guesses || sweep) && kept.len() >= MIN_SAMPLES;
+    if guess_params.is_none() && bootstrap {
+        // Match a subset with identity guesses (an evenly spread one of long logs,
+        // every pair of short ones), solve roughly, and guess the rest — and the
+        // subset's failures — by odometry with that estimate (with a sweep:
+        // compensate with it too).
+        let every = (kept.len() / BOOTSTRAP_PAIRS).max(1);
+        let subset: Vec<usize> = if kept.len() >= 2 * BOOTSTRAP_PAIRS {
+            (0..kept.len()).step_by(every).collect()
+        } else {
+            (0..kept.len()).collect()
+        };
         let sub_pairs: Vec<(usize, usize)> = subset.iter().map(|&i| index_pairs[i]).collect();
         let identity = vec![Pose2::IDENTITY; subset.len()];
         let results = match_pairs(&log.scans, &sub_pairs, &identity, &opts.icp, || {
@@ -272,7 +294,29 @@ pub fn synchronize_and_match(
             .map(|c| c.params)
             .filter(|p| p.r_l > 0.0 && p.r_r > 0.0 && p.b > 0.0);
         for (i, r) in subset.into_iter().zip(results) {
-            matched[i] = Some(r);
+            // A failure is matched again from the odometry guess when there is one.
+            if r.is_ok() || guess_params.is_none() {
+                matched[i] = Some(r);
+            }
+        }
+    }
+    // With a sweep and an estimate to compensate it with, every pair is matched on the
+    // compensated scans (the bootstrap's matches are replaced).
+    let mut scans = Cow::Borrowed(&log.scans);
+    let mut uncovered = vec![false; kept.len()];
+    if let (true, Some(p)) = (sweep, guess_params.as_ref()) {
+        let (store, covered) = compensated_pairs(
+            &log.scans,
+            &index_pairs,
+            &track,
+            &limits,
+            p,
+            opts.time_offset,
+        );
+        scans = Cow::Owned(store);
+        for (i, ok) in covered.into_iter().enumerate() {
+            uncovered[i] = !ok;
+            matched[i] = (!ok).then(|| Err("the encoders do not cover the sweep".into()));
         }
     }
     let rest: Vec<usize> = (0..kept.len()).filter(|&i| matched[i].is_none()).collect();
@@ -280,9 +324,10 @@ pub fn synchronize_and_match(
         rest.iter().map(|&i| (i, kept[i].1.clone())).collect();
     let guesses = first_guesses(&rest_motions, guess_params.as_ref(), opts.use_profile);
     let rest_pairs: Vec<(usize, usize)> = rest.iter().map(|&i| index_pairs[i]).collect();
-    let results = match_pairs(&log.scans, &rest_pairs, &guesses, &opts.icp, || {
+    let results = match_pairs(&scans, &rest_pairs, &guesses, &opts.icp, || {
         progress.advance()
     });
+    let sweep_compensated = matches!(scans, Cow::Owned(_));
     for (i, r) in rest.into_iter().zip(results) {
         matched[i] = Some(r);
     }
@@ -290,13 +335,14 @@ pub fn synchronize_and_match(
     timing.r#match += t_match.elapsed().as_secs_f64();
 
     let mut samples = Vec::with_capacity(kept.len());
-    for ((k, wheel), m) in kept.into_iter().zip(matched) {
+    for (((k, wheel), m), uncovered) in kept.into_iter().zip(matched).zip(uncovered) {
         match m.unwrap_or_else(|| Err("not matched".into())) {
             Ok(icp) => samples.push(PairSample {
                 pair: pairs[k],
                 wheel,
                 icp,
             }),
+            Err(_) if uncovered => discarded.add(DiscardReason::EncoderGap),
             Err(_) => discarded.add(DiscardReason::MatchFailed),
         }
     }
@@ -308,10 +354,13 @@ pub fn synchronize_and_match(
         samples,
         discarded,
         time_offset: opts.time_offset,
+        sweep_compensated,
     })
 }
 
-/// Matches the samples again with first guesses from `params`.
+/// Matches the samples again with first guesses from `params` — and, when the scans
+/// were swept, after compensating the sweep with `params` (samples whose sweeps the
+/// encoders do not cover are discarded as encoder gaps).
 fn second_pass(
     log: &Log,
     synced: &mut Synchronized,
@@ -331,16 +380,32 @@ fn second_pass(
         .iter()
         .map(|s| (s.pair.first, s.pair.second))
         .collect();
+    let (scans, covered) = if has_sweep(&log.scans) {
+        let track = EncoderTrack::new(&log.encoders, synced.ticks_per_revolution);
+        let (store, covered) = compensated_pairs(
+            &log.scans,
+            &index_pairs,
+            &track,
+            &synced.limits,
+            params,
+            synced.time_offset,
+        );
+        synced.sweep_compensated = true;
+        (Cow::<ScanStore>::Owned(store), covered)
+    } else {
+        (Cow::Borrowed(&log.scans), vec![true; index_pairs.len()])
+    };
     progress.start("matching (second pass)", index_pairs.len());
     let matched: Vec<Result<MatchStats, String>> =
-        match_pairs(&log.scans, &index_pairs, &guesses, &opts.icp, || {
+        match_pairs(&scans, &index_pairs, &guesses, &opts.icp, || {
             progress.advance()
         });
     progress.finish();
     let old = std::mem::take(&mut synced.samples);
-    for (s, m) in old.into_iter().zip(matched) {
+    for ((s, m), covered) in old.into_iter().zip(matched).zip(covered) {
         match m {
-            Ok(icp) => synced.samples.push(PairSample { icp, ..s }),
+            Ok(icp) if covered => synced.samples.push(PairSample { icp, ..s }),
+            Ok(_) => synced.discarded.add(DiscardReason::EncoderGap),
             Err(_) => synced.discarded.add(DiscardReason::MatchFailed),
         }
     }
@@ -410,6 +475,8 @@ pub fn calibrate_log(
     let mut synced = synchronize_and_match(log, opts, progress, &mut timing)
         .map_err(|e| PipelineError::with_faults(e, &findings))?;
     findings.extend(health::clock_offset::quick_check(log, &synced, opts));
+    // A swept log is matched again after compensating with the refined estimate.
+    let sweep = has_sweep(&log.scans);
 
     let mut offset = None;
     if let Some(range) = opts.estimate_time_offset {
@@ -439,11 +506,18 @@ pub fn calibrate_log(
     findings.extend(health::slip::episodes(log, &synced));
 
     let t_solve = Instant::now();
+    // With a sweep this estimate only compensates the sweep again (at the offset now
+    // used): the verdicts are those of the final solve.
+    let lenient = Options {
+        accept_weak: true,
+        ..opts.clone()
+    };
+    let first = if sweep { &lenient } else { opts };
     let mut calibration =
-        solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
+        solve(&synced, first).map_err(|e| PipelineError::with_faults(e, &findings))?;
     timing.solve += t_solve.elapsed().as_secs_f64();
 
-    if opts.second_pass {
+    if opts.second_pass || sweep {
         let t = Instant::now();
         second_pass(log, &mut synced, &calibration.params, opts, progress);
         timing.r#match += t.elapsed().as_secs_f64();

@@ -1,6 +1,8 @@
 //! The report of a calibration: what `--json` prints and `results.json` holds, and
 //! the human summary.
 
+use crate::finding::{Finding, Severity};
+use crate::provenance::Provenance;
 use odocal_log::Log;
 use odocal_pipeline::consistency::Consistency;
 use odocal_pipeline::sync::DiscardCounts;
@@ -71,6 +73,23 @@ pub struct Report {
     /// Estimated clock offset (s, laser clock minus encoder clock), when asked.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_s: Option<f64>,
+    /// The nominal parameters given (`--nominal`), order r_L, r_R, b, ℓx, ℓy, ℓθ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal: Option<[f64; 6]>,
+    /// With nominal values: `estimate / nominal` of r_L, r_R and b, what to multiply
+    /// the robot's configured values by.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correction_factors: Option<[f64; 3]>,
+    /// Consistency checks of the result (e.g. the two halves of the log agree).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub checks: Vec<Finding>,
+    /// Command line, version, input checksum and wall time, when the caller gives them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
+    /// Duration of one laser sweep (s), when the rays were taken one after another and
+    /// the sweep was compensated before matching.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep_compensated_s: Option<f64>,
     /// Trimming rule, refinement, profile use.
     pub settings: Settings,
     /// Wall time per stage (s).
@@ -117,6 +136,28 @@ pub struct Settings {
     pub accept_weak: bool,
 }
 
+/// The two-halves check as a finding: a note when the halves agree or could not
+/// be checked, a warning when they disagree beyond 3σ.
+fn two_halves(c: &Consistency) -> Finding {
+    let (severity, message) = match c {
+        Consistency::Checked(h) if h.agree => (Severity::Info, h.sentence.clone()),
+        Consistency::Checked(h) => (Severity::Warning, h.sentence.clone()),
+        Consistency::NotAvailable { reason } => (
+            Severity::Info,
+            format!("the two halves of the log were not compared: {reason}"),
+        ),
+    };
+    Finding {
+        kind: "two_halves".into(),
+        severity,
+        count: 1,
+        first_line: None,
+        time: None,
+        spans: Vec::new(),
+        message,
+    }
+}
+
 /// Builds the report of a finished calibration.
 pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -> Report {
     let c = &outcome.calibration;
@@ -157,6 +198,19 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         consistency: outcome.consistency.clone(),
         shared_scan_noise: c.shared_scan_noise,
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
+        nominal: opts.initial_params.map(|p| p.to_vector()),
+        correction_factors: opts
+            .initial_params
+            .map(|n| [v[0] / n.r_l, v[1] / n.r_r, v[2] / n.b]),
+        checks: vec![two_halves(&outcome.consistency)],
+        provenance: None,
+        sweep_compensated_s: outcome.synced.sweep_compensated.then(|| {
+            log.scans
+                .geometries
+                .iter()
+                .map(|g| g.sweep_duration().abs())
+                .fold(0.0, f64::max)
+        }),
         settings: Settings {
             trim: opts.solve.trim,
             refine: opts.solve.refine,
@@ -299,12 +353,12 @@ impl fmt::Display for Report {
         if let Some(w) = &o.wheel_signs {
             writeln!(f, "  warning: {w}")?;
         }
-        match &self.consistency {
-            Consistency::Checked(h) if h.agree => writeln!(f, "  consistency: {}", h.sentence)?,
-            Consistency::Checked(h) => writeln!(f, "  warning: {}", h.sentence)?,
-            Consistency::NotAvailable { reason } => {
-                writeln!(f, "  consistency: not checked ({reason})")?
-            }
+        if let Some(t) = self.sweep_compensated_s {
+            writeln!(
+                f,
+                "  sweep: {:.1} ms per scan, compensated (rays moved to mid-sweep with the wheel motion)",
+                t * 1e3
+            )?;
         }
         if let Some(t) = self.time_offset_s {
             writeln!(
@@ -312,6 +366,16 @@ impl fmt::Display for Report {
                 "  clock offset (laser clock − encoder clock): {:+.4} s",
                 t
             )?;
+        }
+        if let Some(c) = self.correction_factors {
+            writeln!(
+                f,
+                "  correction factors (calibrated / nominal): r_L ×{:.6}, r_R ×{:.6}, b ×{:.6}",
+                c[0], c[1], c[2]
+            )?;
+        }
+        for finding in &self.checks {
+            writeln!(f, "  {finding}")?;
         }
         let t = &self.timing_s;
         writeln!(

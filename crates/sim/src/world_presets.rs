@@ -89,6 +89,7 @@ impl World {
             (14.2, 3.6),
             (3.2, 2.6),
             (11.8, 1.9),
+            (10.3, 3.9),
         ] {
             s.extend(rect(x - 0.2, y - 0.2, x + 0.2, y + 0.2));
         }
@@ -96,6 +97,7 @@ impl World {
         s.extend(rect(6.3, 6.9, 7.5, 7.8));
         s.extend(rect(18.6, 9.2, 20.0, 10.6));
         s.extend(rect(0.0, 5.2, 0.8, 6.6));
+        s.extend(rect(12.6, 4.9, 13.5, 5.6));
         // A partition hanging from the north wall.
         s.push(Segment::new([9.8, 12.0], [9.8, 9.6]));
         World::new("hall", s).with_home([10.0, 6.0])
