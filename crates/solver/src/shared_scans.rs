@@ -20,6 +20,11 @@
 //! estimator is unchanged (weighted least squares); its covariance is the sandwich
 //! `H⁻¹ Var(Σ GᵀWe) H⁻¹` with `Var(Σ GᵀWe) = Σ_k GᵀWNWG + Σ_j U_j D U_jᵀ`,
 //! `U_j` summing `GᵀWA` and `GᵀWB` over the samples that use scan `j`.
+//!
+//! `N` is a small difference of large moments (70–90 % of the residual variance is
+//! shared on simulated logs), so its estimate is noisy, and a chance low estimate
+//! would make everything that sums over samples look far too certain: it enters at
+//! its estimate plus one standard error (σ lean large by up to ~30 %, measured).
 
 use crate::kinematics::{residual_of, Predictor};
 use crate::noise::NoiseWeights;
@@ -77,6 +82,20 @@ fn weight(weights: &NoiseWeights, index: usize) -> Matrix3<f64> {
     }
 }
 
+/// Per component: standard error of the mean of every other entry of `v`.
+fn standard_error(v: &[Vector3<f64>]) -> Vector3<f64> {
+    let every_other: Vec<&Vector3<f64>> = v.iter().step_by(2).collect();
+    let m = every_other.len() as f64;
+    if m < 2.0 {
+        return Vector3::zeros();
+    }
+    let mean = every_other.iter().fold(Vector3::zeros(), |acc, x| acc + *x) / m;
+    let var = every_other.iter().fold(Vector3::zeros(), |acc, x| {
+        acc + (*x - mean).component_mul(&(*x - mean))
+    }) / (m - 1.0);
+    var.map(|v| (v / m).sqrt())
+}
+
 fn to_array3(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
     std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
 }
@@ -109,14 +128,21 @@ pub(crate) fn score_covariance(
     // D from consecutive residuals: B⁻¹ e_{k+1} e_kᵀ A⁻ᵀ (A is a rotation).
     let mut cross = Matrix3::zeros();
     let mut shared = 0;
+    // Per shared scan, per component: (e_k² + e_next²)/2 − 2·(shared product), whose
+    // mean is about N_cc: its scatter gives the standard error of N̂.
+    let mut unshared: Vec<Vector3<f64>> = Vec::new();
     for (k, t) in times.iter().enumerate() {
         let Some(&next) = starts.get(&t[1].to_bits()) else {
             continue;
         };
         let b_inv = start_map(&samples[next].sm).try_inverse()?;
         let a = end_map(&samples[k].sm);
-        cross += b_inv * e[next] * e[k].transpose() * a;
+        let product = b_inv * e[next] * e[k].transpose() * a;
+        cross += product;
         shared += 1;
+        unshared.push(Vector3::from_fn(|c, _| {
+            0.5 * (e[k][c] * e[k][c] + e[next][c] * e[next][c]) - 2.0 * product[(c, c)]
+        }));
     }
     if shared < MIN_SHARED_SCANS {
         return None;
@@ -127,7 +153,11 @@ pub(crate) fn score_covariance(
         let (a, b) = (end_map(&s.sm), start_map(&s.sm));
         total += ek * ek.transpose() - a * d * a.transpose() - b * d * b.transpose();
     }
-    let n = nearest_psd(&(total / samples.len() as f64));
+    // N is a small difference of large moments: a chance low estimate would make
+    // everything that sums over samples look far too certain. Use its upper bound,
+    // N̂ + SE (SE from every other shared scan, which share no sample).
+    let n_hat = total / samples.len() as f64 + Matrix3::from_diagonal(&standard_error(&unshared));
+    let n = nearest_psd(&n_hat);
 
     let mut m = Matrix6::zeros();
     // Ordered by time, so that the sums (and the covariance) are reproducible.
