@@ -19,7 +19,8 @@ use std::borrow::Cow;
 use std::time::Instant;
 
 /// Pairs matched with identity first guesses to bootstrap the odometry guesses of
-/// the others (only when there are at least twice as many pairs).
+/// the others when there are at least twice as many pairs (with fewer, all pairs are
+/// matched from identity first, and the failures again from odometry).
 pub const BOOTSTRAP_PAIRS: usize = 300;
 
 /// Fewest samples the pipeline hands to the solver.
@@ -46,9 +47,10 @@ pub struct Options {
     pub estimate_time_offset: Option<f64>,
     /// Parameters for the first guesses of scan matching (odometry prediction).
     pub initial_params: Option<Params>,
-    /// Without `initial_params`: match [`BOOTSTRAP_PAIRS`] evenly spread pairs with
-    /// identity guesses, solve roughly, and guess the other pairs by odometry with
-    /// that estimate (fewer ICP iterations and failures). Off: identity for all.
+    /// Without `initial_params`: match [`BOOTSTRAP_PAIRS`] evenly spread pairs (all
+    /// pairs of a shorter log) with identity guesses, solve roughly, and guess the
+    /// other pairs and the failed ones by odometry with that estimate (fewer ICP
+    /// iterations and failures). Off: identity for all.
     pub bootstrap_guesses: bool,
     /// Match again with first guesses predicted from the first estimate.
     pub second_pass: bool,
@@ -250,14 +252,18 @@ pub fn synchronize_and_match(
     progress.start("matching", index_pairs.len());
     let mut matched: Vec<Option<Result<MatchStats, String>>> = vec![None; kept.len()];
     let mut guess_params = opts.initial_params;
-    let bootstrap = (opts.bootstrap_guesses && kept.len() >= 2 * BOOTSTRAP_PAIRS)
-        || (sweep && kept.len() >= MIN_SAMPLES);
+    let bootstrap = (opts.bootstrap_guesses || sweep) && kept.len() >= MIN_SAMPLES;
     if guess_params.is_none() && bootstrap {
-        // Match an evenly spread subset with identity guesses, solve roughly, and
-        // guess the rest by odometry with that estimate (with a sweep: compensate
-        // with it too).
+        // Match a subset with identity guesses (an evenly spread one of long logs,
+        // every pair of short ones), solve roughly, and guess the rest — and the
+        // subset's failures — by odometry with that estimate (with a sweep:
+        // compensate with it too).
         let every = (kept.len() / BOOTSTRAP_PAIRS).max(1);
-        let subset: Vec<usize> = (0..kept.len()).step_by(every).collect();
+        let subset: Vec<usize> = if kept.len() >= 2 * BOOTSTRAP_PAIRS {
+            (0..kept.len()).step_by(every).collect()
+        } else {
+            (0..kept.len()).collect()
+        };
         let sub_pairs: Vec<(usize, usize)> = subset.iter().map(|&i| index_pairs[i]).collect();
         let identity = vec![Pose2::IDENTITY; subset.len()];
         let results = match_pairs(&log.scans, &sub_pairs, &identity, &opts.icp, || {
@@ -285,7 +291,10 @@ pub fn synchronize_and_match(
             .map(|c| c.params)
             .filter(|p| p.r_l > 0.0 && p.r_r > 0.0 && p.b > 0.0);
         for (i, r) in subset.into_iter().zip(results) {
-            matched[i] = Some(r);
+            // A failure is matched again from the odometry guess when there is one.
+            if r.is_ok() || guess_params.is_none() {
+                matched[i] = Some(r);
+            }
         }
     }
     // With a sweep and an estimate to compensate it with, every pair is matched on the
