@@ -5,7 +5,7 @@ use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
 use odocal_pipeline::{calibrate_log, Options, Trim};
-use odocal_report::{build_report, write_outputs};
+use odocal_report::{build_report, sha256_of_file, write_html, write_outputs, Provenance};
 use odocal_solver::Params;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -91,12 +91,15 @@ pub struct Args {
     pub second_pass: bool,
     #[command(flatten)]
     pub partial: PartialArgs,
-    /// Write results.json, samples.tuple (and figures with --plots) into DIR.
+    /// Write results.json, samples.tuple, results.html (and figures with --plots) into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// With --out: also write SVG figures.
+    /// With --out: also write each figure as an SVG file.
     #[arg(long, requires = "out")]
     pub plots: bool,
+    /// Write the one-page report (self-contained HTML: tables and figures) to FILE.
+    #[arg(long, value_name = "FILE.html")]
+    pub report: Option<PathBuf>,
     /// Print one JSON object instead of the human summary.
     #[arg(long)]
     pub json: bool,
@@ -119,6 +122,7 @@ fn nominal_params(v: &[f64]) -> anyhow::Result<Params> {
 
 /// Runs `odocal calibrate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let started = Instant::now();
     let input = &args.input;
     let pool = input.thread_pool()?;
     let t_parse = Instant::now();
@@ -147,9 +151,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let bar = Bar::for_stderr();
     let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
     outcome.timing.parse = parse_s;
-    let report = build_report(&input.read.log, &log, &opts, &outcome);
+    let mut report = build_report(&input.read.log, &log, &opts, &outcome);
+    let (input_sha256, input_bytes) = sha256_of_file(&input.read.log)
+        .with_context(|| format!("cannot read {} for its checksum", input.read.log.display()))?;
+    report.provenance = Some(Provenance {
+        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        input_sha256,
+        input_bytes,
+        wall_time_s: started.elapsed().as_secs_f64(),
+    });
 
-    // The results are printed whatever happens to --out, so they are never lost.
+    // The results are printed whatever happens to --out and --report, so they are never lost.
+    let written_report = args.report.as_ref().map(|path| {
+        write_html(path, &opts, &outcome, &report)
+            .with_context(|| format!("cannot write the report {}", path.display()))
+    });
     let written = args.out.as_ref().map(|dir| {
         write_outputs(dir, &opts, &outcome, &report, args.plots)
             .with_context(|| format!("cannot write the results into {}", dir.display()))
@@ -163,6 +180,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (Some(Err(e)), _) => return Err(e.context("the results above were printed only")),
         (Some(Ok(())), Some(dir)) if !args.json => {
             println!("results written to {}", dir.display())
+        }
+        _ => {}
+    }
+    match (written_report, &args.report) {
+        (Some(Err(e)), _) => return Err(e.context("the results above were printed only")),
+        (Some(Ok(())), Some(path)) if !args.json => {
+            println!("report written to {}", path.display())
         }
         _ => {}
     }

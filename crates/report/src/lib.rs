@@ -1,5 +1,7 @@
 //! The report of a calibration: the human summary and `results.json` ([`report`]),
-//! the files `--out DIR` writes ([`output`]) and the figures ([`svg`]).
+//! findings and checks other stages add to it ([`finding`]), where the run came from
+//! ([`provenance`]), the figures ([`figures`], drawn with `plotters`), the one-page
+//! `results.html` ([`html`]) and the files `--out DIR` writes ([`output`]).
 //!
 //! ```no_run
 //! use odocal_pipeline::{calibrate_log, NoProgress, Options};
@@ -14,9 +16,14 @@
 
 #![deny(missing_docs)]
 
+pub mod figures;
+pub mod finding;
+pub mod html;
 pub mod output;
+pub mod provenance;
 pub mod report;
-pub mod svg;
 
-pub use output::write_outputs;
+pub use finding::{Finding, Severity};
+pub use output::{html_report, write_html, write_outputs};
+pub use provenance::{sha256_of_file, Provenance};
 pub use report::{build_report, Report};

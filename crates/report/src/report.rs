@@ -1,6 +1,8 @@
 //! The report of a calibration: what `--json` prints and `results.json` holds, and
 //! the human summary.
 
+use crate::finding::Finding;
+use crate::provenance::Provenance;
 use odocal_log::Log;
 use odocal_pipeline::sync::DiscardCounts;
 use odocal_pipeline::{Estimate, Options, Outcome, Timing};
@@ -65,6 +67,19 @@ pub struct Report {
     /// Estimated clock offset (s, laser clock minus encoder clock), when asked.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_s: Option<f64>,
+    /// The nominal parameters given (`--nominal`), order r_L, r_R, b, ℓx, ℓy, ℓθ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal: Option<[f64; 6]>,
+    /// With nominal values: `estimate / nominal` of r_L, r_R and b, what to multiply
+    /// the robot's configured values by.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correction_factors: Option<[f64; 3]>,
+    /// Consistency checks of the result (e.g. the two halves of the log agree).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub checks: Vec<Finding>,
+    /// Command line, version, input checksum and wall time, when the caller gives them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
     /// Duration of one laser sweep (s), when the rays were taken one after another and
     /// the sweep was compensated before matching.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -153,6 +168,12 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         cost_after: c.cost_after,
         observability: c.observability.clone(),
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
+        nominal: opts.initial_params.map(|p| p.to_vector()),
+        correction_factors: opts
+            .initial_params
+            .map(|n| [v[0] / n.r_l, v[1] / n.r_r, v[2] / n.b]),
+        checks: Vec::new(),
+        provenance: None,
         sweep_compensated_s: outcome.synced.sweep_compensated.then(|| {
             log.scans
                 .geometries
@@ -304,6 +325,16 @@ impl fmt::Display for Report {
                 "  clock offset (laser clock − encoder clock): {:+.4} s",
                 t
             )?;
+        }
+        if let Some(c) = self.correction_factors {
+            writeln!(
+                f,
+                "  correction factors (calibrated / nominal): r_L ×{:.6}, r_R ×{:.6}, b ×{:.6}",
+                c[0], c[1], c[2]
+            )?;
+        }
+        for finding in &self.checks {
+            writeln!(f, "  {finding}")?;
         }
         let t = &self.timing_s;
         writeln!(

@@ -72,7 +72,8 @@ pub use error::SolveError;
 pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
 pub use observability::{
-    MotionContent, Observability, ParameterReport, Verdict, PARTIAL_CALIBRATION_HINT,
+    MotionContent, Observability, ParameterReport, Verdict, MOTION_CLASS_RATIO,
+    PARTIAL_CALIBRATION_HINT,
 };
 pub use params::{Params, PARAMETER_NAMES};
 pub use refine::Refinement;
