@@ -43,7 +43,20 @@ enum Command {
     TableI(table_i::Args),
 }
 
+/// Lets a closed pipe end the process quietly, as it does `cat` or `grep`
+/// (`odocal info run.log | head`): Rust ignores SIGPIPE, so without this every
+/// `println!` after the reader has gone would panic with "Broken pipe".
+fn exit_quietly_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in `main`, before any other thread exists; SIG_DFL
+    // is a valid disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    exit_quietly_on_closed_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Calibrate(a) => calibrate::run(a),
