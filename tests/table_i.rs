@@ -113,14 +113,14 @@ fn simulated_samples_match_the_pipeline_stride() {
 }
 
 #[test]
-#[ignore = "full-size rows take about a minute; CI runs them with --include-ignored"]
+#[ignore = "full-size rows (75,626 samples) take 1-3 minutes; CI runs them with --include-ignored"]
 fn full_size_rows_meet_every_bound() {
     let tol = Tolerances::default();
     check_rows(|row| row.samples as usize, &tol);
 }
 
 #[test]
-#[ignore = "measures the 3σ rule over many seeds (about a minute); CI runs it with --include-ignored"]
+#[ignore = "measures the 3σ rule over 8 seeds (100,000 samples, 1-3 minutes); CI runs it with --include-ignored"]
 fn three_sigma_rule_holds_over_seeds() {
     const SEEDS: u64 = 8;
     let rows = published_rows();
