@@ -7,7 +7,8 @@
 
 use odocal_bag::{read_bag, BagOptions, TopicChoice};
 use odocal_log::{encoders_from_odometry, NominalWheels, ValueSource, WHEEL_TICKS_PER_REVOLUTION};
-use odocal_pipeline::{build_report, calibrate_log, NoProgress, Options};
+use odocal_pipeline::{calibrate_log, NoProgress, Options};
+use odocal_report::build_report;
 use std::path::{Path, PathBuf};
 
 fn fixture(name: &str) -> PathBuf {

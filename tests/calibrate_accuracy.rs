@@ -5,62 +5,14 @@
 
 mod common;
 
+use common::accuracy::{calibrate, check as check_within};
 use common::{cleanup, simulated_log, Truth};
-use odocal_log::{read_log, ReadOptions};
-use odocal_pipeline::{build_report, calibrate_log, NoProgress, Options, Report};
-
-const NAMES: [&str; 6] = ["r_L", "r_R", "b", "l_x", "l_y", "l_theta"];
-
-fn calibrate(path: &std::path::Path, opts: &Options) -> Report {
-    let log = read_log(path, &ReadOptions::default()).expect("the simulated log reads");
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
-    let outcome = pool
-        .install(|| calibrate_log(&log, opts, &NoProgress))
-        .expect("calibration succeeds");
-    build_report(path, &log, opts, &outcome)
-}
+use odocal_pipeline::Options;
+use odocal_report::Report;
 
 /// Asserts the bounds and the 3σ consistency; prints the errors in σ.
 fn check(label: &str, report: &Report, truth: &Truth) {
-    let est = report.values();
-    let bounds = [
-        0.0035 * truth[0],
-        0.0035 * truth[1],
-        0.0035 * truth[2],
-        1.5e-3,
-        1.5e-3,
-        0.2f64.to_radians(),
-    ];
-    let mut failures = Vec::new();
-    let mut line = format!("{label}: {} samples;", report.samples_used);
-    for i in 0..6 {
-        let err = est[i] - truth[i];
-        let sigma = report.sigma[i];
-        line += &format!(" {} {:+.2e} ({:+.2}σ)", NAMES[i], err, err / sigma);
-        if err.abs() > bounds[i] {
-            failures.push(format!(
-                "{}: error {err:.3e} above the bound {:.3e}",
-                NAMES[i], bounds[i]
-            ));
-        }
-        if err.is_nan() || err.abs() > 3.0 * sigma {
-            failures.push(format!(
-                "{}: error {err:.3e} beyond 3σ = {:.3e}",
-                NAMES[i],
-                3.0 * sigma
-            ));
-        }
-    }
-    println!("{line}");
-    assert!(
-        report.samples_used > 1000,
-        "{label}: only {} samples used",
-        report.samples_used
-    );
-    assert!(failures.is_empty(), "{label}: {}", failures.join("; "));
+    check_within(label, report, truth, 3.0, 1000);
 }
 
 #[test]

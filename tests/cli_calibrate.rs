@@ -4,19 +4,8 @@
 
 mod common;
 
-use common::{cleanup, simulated_log, temp_dir};
-use std::process::{Command, Output};
-
-fn odocal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_odocal"))
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use common::{cleanup, odocal, simulated_log, stderr, temp_dir};
+use std::process::Output;
 
 /// One line on stderr starting with "error:", non-zero exit, no panic.
 fn assert_clean_failure(o: &Output) -> String {
@@ -101,23 +90,49 @@ fn json_output_and_out_dir() {
     let total: f64 = profile.iter().map(|p| p[0]).sum();
     assert!((total - t.t).abs() < 1e-9);
     for fig in [
-        "residuals_x.svg",
-        "residuals_y.svg",
-        "residuals_theta.svg",
-        "residuals_time.svg",
         "trajectory.svg",
+        "residuals_time.svg",
+        "residual_histograms.svg",
+        "motion_coverage.svg",
+        "icp_quality.svg",
+        "results.html",
     ] {
         let svg = std::fs::read_to_string(out_dir.join(fig)).unwrap();
         assert!(
-            svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+            (svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"))
+                || (svg.starts_with("<!DOCTYPE html>") && svg.trim_end().ends_with("</html>")),
             "{fig}"
         );
     }
 
-    // Human summary.
-    let o = odocal(&["calibrate", log, "--threads", "1"]);
+    // Where the results came from: the input's SHA-256 and size, the command line.
+    let p = &v["provenance"];
+    let sha = p["input_sha256"].as_str().unwrap();
+    assert!(
+        sha.len() == 64 && sha.bytes().all(|c| c.is_ascii_hexdigit()),
+        "{sha}"
+    );
+    assert_eq!(
+        p["input_bytes"].as_u64().unwrap(),
+        std::fs::metadata(&path).unwrap().len()
+    );
+    assert!(p["command_line"].as_str().unwrap().contains("--plots"));
+
+    // Human summary, and the report page on its own.
+    let page = out_dir.join("page.html");
+    let o = odocal(&[
+        "calibrate",
+        log,
+        "--threads",
+        "1",
+        "--report",
+        page.to_str().unwrap(),
+    ]);
     assert!(o.status.success());
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("id=\"fig-motion_coverage\""));
     let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("report written to"), "{text}");
     for needle in [
         "r_L",
         "l_theta",

@@ -1,5 +1,8 @@
 //! Fuzzing the log reader (and the pipeline behind it) with proptest: garbage bytes,
-//! garbled lines among valid ones, and mutated JSON logs. Every input must give
+//! garbled lines among valid ones (and the data faults of issue 14: duplicated lines,
+//! colliding timestamps, clock jumps, encoder spikes up to `i64::MAX`, frozen scans,
+//! wrapping counters without the modulus, NUL and terminal-escape bytes), and mutated
+//! JSON logs. Every input must give
 //! `Ok` or an error — never a panic — in strict and in lenient mode; whatever reads
 //! is then pushed through the whole pipeline, which must also answer without panic.
 
@@ -21,6 +24,14 @@ fn scratch_file(bytes: &[u8]) -> PathBuf {
     path
 }
 
+/// Messages never carry raw control bytes (terminal escapes, NUL, …) from the input.
+fn assert_printable(message: &str) {
+    assert!(
+        !message.chars().any(|c| c.is_control()),
+        "raw control bytes in {message:?}"
+    );
+}
+
 /// Reads `bytes` as a log in both modes and, when it reads, calibrates it.
 fn exercise(bytes: &[u8]) {
     let path = scratch_file(bytes);
@@ -29,13 +40,23 @@ fn exercise(bytes: &[u8]) {
             mode,
             ..ReadOptions::default()
         };
-        if let Ok(log) = read_log(&path, &opts) {
-            let calib = Options {
-                ticks_per_revolution: Some(1000.0),
-                ..Options::default()
-            };
-            // Ok or a clear error; the point is that nothing panics.
-            let _ = calibrate_log(&log, &calib, &NoProgress).map(|o| o.calibration.params);
+        match read_log(&path, &opts) {
+            Ok(log) => {
+                let calib = Options {
+                    ticks_per_revolution: Some(1000.0),
+                    ..Options::default()
+                };
+                // Ok or a clear error; the point is that nothing panics.
+                match calibrate_log(&log, &calib, &NoProgress) {
+                    Ok(o) => {
+                        for f in &o.health {
+                            assert_printable(&f.message);
+                        }
+                    }
+                    Err(e) => assert_printable(&e.to_string()),
+                }
+            }
+            Err(e) => assert_printable(&e.to_string()),
         }
     }
     let _ = std::fs::remove_file(&path);
@@ -96,6 +117,14 @@ enum Edit {
     DeleteLine(usize),
     SwapLines(usize, usize),
     Truncate(usize, usize),
+    // The data faults of issue 14.
+    DuplicateLine(usize),
+    SameTimestampAsPrevious(usize),
+    ClockJump(usize, f64),
+    EncoderSpike(usize, i64),
+    FrozenScan(usize),
+    WrapCounters(u32),
+    InsertBytes(usize, Vec<u8>),
 }
 
 fn edit() -> impl Strategy<Value = Edit> {
@@ -107,7 +136,42 @@ fn edit() -> impl Strategy<Value = Edit> {
         any::<usize>().prop_map(Edit::DeleteLine),
         (any::<usize>(), any::<usize>()).prop_map(|(a, b)| Edit::SwapLines(a, b)),
         (any::<usize>(), any::<usize>()).prop_map(|(l, c)| Edit::Truncate(l, c)),
+        any::<usize>().prop_map(Edit::DuplicateLine),
+        any::<usize>().prop_map(Edit::SameTimestampAsPrevious),
+        (any::<usize>(), -20.0f64..20.0).prop_map(|(l, d)| Edit::ClockJump(l, d)),
+        (
+            any::<usize>(),
+            prop_oneof![
+                Just(i64::MAX),
+                Just(i64::MIN),
+                Just(1_000_000_000_000i64),
+                any::<i64>()
+            ]
+        )
+            .prop_map(|(l, v)| Edit::EncoderSpike(l, v)),
+        any::<usize>().prop_map(Edit::FrozenScan),
+        (8u32..20).prop_map(Edit::WrapCounters),
+        (
+            any::<usize>(),
+            prop::collection::vec(
+                prop_oneof![Just(0u8), Just(0x1b), Just(0x9b), Just(0x07), any::<u8>()],
+                1..8
+            )
+        )
+            .prop_map(|(l, b)| Edit::InsertBytes(l, b)),
     ]
+}
+
+/// The timestamp token (third from the end) of a message line, when it has one.
+fn timestamp_index(toks: &[String]) -> Option<usize> {
+    (toks.len() >= 4 && toks[0] != "PARAM" && !toks[0].starts_with('#')).then(|| toks.len() - 3)
+}
+
+/// Applies `f` to the tokens of line `l`.
+fn with_tokens(line: &mut String, f: impl FnOnce(&mut Vec<String>)) {
+    let mut toks: Vec<String> = line.split_whitespace().map(String::from).collect();
+    f(&mut toks);
+    *line = toks.join(" ");
 }
 
 fn edit_tokens(line: &mut String, t: usize, replacement: Option<&str>) {
@@ -145,6 +209,84 @@ fn apply(lines: &mut Vec<String>, e: &Edit) {
                 cut -= 1;
             }
             line.truncate(cut);
+        }
+        Edit::DuplicateLine(l) => {
+            let copy = lines[l % n].clone();
+            lines.insert(l % n, copy);
+        }
+        Edit::SameTimestampAsPrevious(l) => {
+            let k = l % n;
+            let prev = (0..k).rev().find_map(|j| {
+                let t: Vec<String> = lines[j].split_whitespace().map(String::from).collect();
+                timestamp_index(&t).map(|i| t[i].clone())
+            });
+            if let Some(t) = prev {
+                with_tokens(&mut lines[k], |toks| {
+                    if let Some(i) = timestamp_index(toks) {
+                        toks[i] = t;
+                    }
+                });
+            }
+        }
+        Edit::ClockJump(l, d) => {
+            for line in lines
+                .iter_mut()
+                .skip(l % n)
+                .filter(|x| x.starts_with("RAWLASER1"))
+            {
+                with_tokens(line, |toks| {
+                    if let Some(i) = timestamp_index(toks) {
+                        if let Ok(t) = toks[i].parse::<f64>() {
+                            toks[i] = format!("{:.6}", t + d);
+                        }
+                    }
+                });
+            }
+        }
+        Edit::EncoderSpike(l, v) => {
+            if let Some(line) = lines
+                .iter_mut()
+                .skip(l % n)
+                .find(|x| x.starts_with("ENCODER"))
+            {
+                with_tokens(line, |toks| toks[1] = v.to_string());
+            }
+        }
+        Edit::FrozenScan(l) => {
+            let k = l % n;
+            if let Some(a) = (k..n).find(|&j| lines[j].starts_with("RAWLASER1")) {
+                if let Some(b) = (a + 1..n).find(|&j| lines[j].starts_with("RAWLASER1")) {
+                    let t: Vec<String> = lines[b].split_whitespace().map(String::from).collect();
+                    let mut frozen: Vec<String> =
+                        lines[a].split_whitespace().map(String::from).collect();
+                    if let (Some(i), Some(j)) = (timestamp_index(&t), timestamp_index(&frozen)) {
+                        frozen[j] = t[i].clone();
+                    }
+                    lines[b] = frozen.join(" ");
+                }
+            }
+        }
+        Edit::WrapCounters(bits) => {
+            lines.retain(|x| !x.starts_with("PARAM robot_encoder_modulus"));
+            let m = 1i64 << bits;
+            for line in lines.iter_mut().filter(|x| x.starts_with("ENCODER")) {
+                with_tokens(line, |toks| {
+                    for k in [1, 2] {
+                        if let Some(v) = toks.get(k).and_then(|t| t.parse::<i64>().ok()) {
+                            toks[k] = v.rem_euclid(m).to_string();
+                        }
+                    }
+                });
+            }
+        }
+        Edit::InsertBytes(l, bytes) => {
+            let line = &mut lines[l % n];
+            let at = line.len() / 2;
+            let mut cut = at;
+            while !line.is_char_boundary(cut) {
+                cut -= 1;
+            }
+            line.insert_str(cut, &String::from_utf8_lossy(bytes));
         }
     }
 }

@@ -1,17 +1,22 @@
 //! `odocal calibrate LOG`: raw log in, calibrated robot out.
 
 use crate::input::InputArgs;
+use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
 use odocal_log::{encoders_from_odometry, NominalWheels, ValueSource, WHEEL_TICKS_PER_REVOLUTION};
-use odocal_pipeline::{build_report, calibrate_log, write_outputs, Options, Trim};
+use odocal_pipeline::{calibrate_log, Options, Trim};
+use odocal_report::{build_report, sha256_of_file, write_html, write_outputs, Provenance};
 use odocal_solver::Params;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// The outlier-trimming rule, as named on the command line.
+/// The outlier-trimming rule, as named on the command line (`calibrate` and `solve`).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TrimArg {
+    /// χ² on the residuals whitened by their robust scale, iterated (the default;
+    /// works at any sample count).
+    Chi2,
     /// ICRA 2008: drop the worst 5 %, three times.
     Icra,
     /// The original package (T-RO 2013): p = 1 %, 4 rounds, xy or θ threshold.
@@ -20,9 +25,22 @@ pub enum TrimArg {
     None,
 }
 
+impl TrimArg {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            TrimArg::Chi2 => "chi2",
+            TrimArg::Icra => "icra",
+            TrimArg::Tro => "tro",
+            TrimArg::None => "none",
+        }
+    }
+}
+
 impl From<TrimArg> for Trim {
     fn from(t: TrimArg) -> Trim {
         match t {
+            TrimArg::Chi2 => Trim::CHI2,
             TrimArg::Icra => Trim::ICRA,
             TrimArg::Tro => Trim::TRO,
             TrimArg::None => Trim::None,
@@ -36,7 +54,7 @@ pub struct Args {
     #[command(flatten)]
     pub input: InputArgs,
     /// Outlier trimming rule.
-    #[arg(long, value_enum, default_value = "tro")]
+    #[arg(long, value_enum, default_value = "chi2")]
     pub trim: TrimArg,
     /// Skip the maximum-likelihood refinement (closed form only).
     #[arg(long)]
@@ -48,9 +66,13 @@ pub struct Args {
     /// estimated from the residuals, which is what the reported σ assume).
     #[arg(long)]
     pub icp_covariance: bool,
-    /// Estimate a constant clock offset between laser and encoders (within ±0.5 s).
+    /// Estimate a constant clock offset between laser and encoders (within
+    /// ±0.5 s of --time-offset, or ±--time-offset-range), before observability is judged.
     #[arg(long)]
     pub estimate_time_offset: bool,
+    /// Half-width (s) of the clock-offset search; implies --estimate-time-offset.
+    #[arg(long, value_name = "S")]
+    pub time_offset_range: Option<f64>,
     /// Nominal parameters "r_L,r_R,b" or "r_L,r_R,b,l_x,l_y,l_theta" (m, rad): first
     /// guesses for scan matching come from odometry with them, and the figures
     /// compare them with the calibrated ones.
@@ -68,15 +90,17 @@ pub struct Args {
     /// Match the scans a second time, with first guesses from the first estimate.
     #[arg(long)]
     pub second_pass: bool,
-    /// Print the numbers even when some parameters are only weakly determined.
-    #[arg(long)]
-    pub accept_weak: bool,
-    /// Write results.json, samples.tuple (and figures with --plots) into DIR.
+    #[command(flatten)]
+    pub partial: PartialArgs,
+    /// Write results.json, samples.tuple, results.html (and figures with --plots) into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// With --out: also write SVG figures.
+    /// With --out: also write each figure as an SVG file.
     #[arg(long, requires = "out")]
     pub plots: bool,
+    /// Write the one-page report (self-contained HTML: tables and figures) to FILE.
+    #[arg(long, value_name = "FILE.html")]
+    pub report: Option<PathBuf>,
     /// Print one JSON object instead of the human summary.
     #[arg(long)]
     pub json: bool,
@@ -132,6 +156,7 @@ fn odometry_only_mode(
 
 /// Runs `odocal calibrate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let started = Instant::now();
     let input = &args.input;
     let pool = input.thread_pool()?;
     let t_parse = Instant::now();
@@ -147,24 +172,40 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         use_profile: !args.constant_speed,
         use_icp_covariance: args.icp_covariance,
         time_offset: input.time_offset,
-        estimate_time_offset: args.estimate_time_offset.then_some(0.5),
+        estimate_time_offset: (args.estimate_time_offset || args.time_offset_range.is_some())
+            .then_some(args.time_offset_range.unwrap_or(0.5)),
         second_pass: args.second_pass,
         bootstrap_guesses: !args.identity_guess,
-        accept_weak: args.accept_weak,
+        accept_weak: args.partial.accept_weak,
         ..Options::default()
     };
     opts.solve.trim = args.trim.into();
     opts.solve.refine = !args.no_refine;
+    opts.solve.constraints = args.partial.constraints()?;
 
     let bar = Bar::for_stderr();
     let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
     outcome.timing.parse = parse_s;
-    let report = build_report(&input.read.log, &log, &opts, &outcome);
+    let mut report = build_report(&input.read.log, &log, &opts, &outcome);
+    let (input_sha256, input_bytes) = sha256_of_file(&input.read.log)
+        .with_context(|| format!("cannot read {} for its checksum", input.read.log.display()))?;
+    report.provenance = Some(Provenance {
+        command_line: std::env::args().collect::<Vec<_>>().join(" "),
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        input_sha256,
+        input_bytes,
+        wall_time_s: started.elapsed().as_secs_f64(),
+    });
 
-    if let Some(dir) = &args.out {
+    // The results are printed whatever happens to --out and --report, so they are never lost.
+    let written_report = args.report.as_ref().map(|path| {
+        write_html(path, &opts, &outcome, &report)
+            .with_context(|| format!("cannot write the report {}", path.display()))
+    });
+    let written = args.out.as_ref().map(|dir| {
         write_outputs(dir, &opts, &outcome, &report, args.plots)
-            .with_context(|| format!("cannot write the results into {}", dir.display()))?;
-    }
+            .with_context(|| format!("cannot write the results into {}", dir.display()))
+    });
     if args.json {
         let mut value = serde_json::to_value(&report)?;
         if let (Some(nominal), Some(obj)) = (&odometry_only, value.as_object_mut()) {
@@ -196,9 +237,20 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 report.b / n.b
             );
         }
-        if let Some(dir) = &args.out {
-            println!("results written to {}", dir.display());
+    }
+    match (written, &args.out) {
+        (Some(Err(e)), _) => return Err(e.context("the results above were printed only")),
+        (Some(Ok(())), Some(dir)) if !args.json => {
+            println!("results written to {}", dir.display())
         }
+        _ => {}
+    }
+    match (written_report, &args.report) {
+        (Some(Err(e)), _) => return Err(e.context("the results above were printed only")),
+        (Some(Ok(())), Some(path)) if !args.json => {
+            println!("report written to {}", path.display())
+        }
+        _ => {}
     }
     Ok(())
 }

@@ -39,11 +39,27 @@ impl InputArgs {
     }
 }
 
-/// A rayon pool with `threads` threads (all cores when `None`); 0 is an error.
+/// Threads per core beyond which `--threads` is capped: more only adds overhead.
+pub const MAX_THREADS_PER_CORE: usize = 4;
+
+/// A rayon pool with `threads` threads (all cores when `None`); 0 is an error, and more
+/// than [`MAX_THREADS_PER_CORE`] per core are capped, with a message.
 pub fn thread_pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> {
     if threads == Some(0) {
         anyhow::bail!("--threads must be at least 1");
     }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let cap = MAX_THREADS_PER_CORE * cores;
+    let threads = match threads {
+        Some(n) if n > cap => {
+            eprintln!(
+                "note: --threads {n} capped at {cap} ({MAX_THREADS_PER_CORE} per core, {cores} \
+                 core(s)); more threads than that only add overhead"
+            );
+            Some(cap)
+        }
+        t => t,
+    };
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()

@@ -3,7 +3,7 @@
 //!
 //! This binary is thin: each subcommand lives in its own module and calls the
 //! library crates (`odocal-log`, `odocal-icp`, `odocal-solver`, `odocal-sim`,
-//! `odocal-pipeline`).
+//! `odocal-pipeline`, `odocal-report`).
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -12,6 +12,7 @@ mod calibrate;
 mod info;
 mod input;
 mod matching;
+mod partial_args;
 mod progress_bar;
 mod read_args;
 mod simulate;
@@ -42,7 +43,20 @@ enum Command {
     TableI(table_i::Args),
 }
 
+/// Lets a closed pipe end the process quietly, as it does `cat` or `grep`
+/// (`odocal info run.log | head`): Rust ignores SIGPIPE, so without this every
+/// `println!` after the reader has gone would panic with "Broken pipe".
+fn exit_quietly_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in `main`, before any other thread exists; SIG_DFL
+    // is a valid disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() -> ExitCode {
+    exit_quietly_on_closed_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Calibrate(a) => calibrate::run(a),

@@ -4,7 +4,7 @@
 use crate::input::InputArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
-use odocal_pipeline::{synchronize_and_match, write_tuples, Options, Timing};
+use odocal_pipeline::{health, synchronize_and_match, write_tuples, Options, Timing};
 use std::path::PathBuf;
 
 /// Arguments of `odocal match`.
@@ -30,7 +30,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let bar = Bar::for_stderr();
     let mut timing = Timing::default();
+    // The data-health stage repairs the log as `calibrate` does, and says what it did.
+    let (log, mut findings) = health::check_log(&log, &opts);
     let synced = pool.install(|| synchronize_and_match(&log, &opts, &bar, &mut timing))?;
+    findings.extend(health::after_matching(&log, &synced, &opts));
+    for f in &findings {
+        eprintln!("{f}");
+    }
     write_tuples(&args.out, &synced.samples)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
     let discarded: Vec<String> = synced

@@ -10,8 +10,8 @@ use std::path::{Path, PathBuf};
 /// Arguments of `odocal simulate`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
-    /// Preset to start from: khepera, khepera-displaced, office, corridor, straight-only,
-    /// spin-only, identical-turns, or a row of the Table I file.
+    /// Preset to start from: khepera, turtlebot, pioneer, khepera-displaced, office,
+    /// corridor, straight-only, spin-only, identical-turns, or a row of the Table I file.
     #[arg(long, default_value = "khepera")]
     preset: String,
     /// Seed of every random choice (same seed and options → same bytes).
@@ -73,7 +73,15 @@ pub struct Args {
     /// Scan timing jitter (± s, uniform).
     #[arg(long)]
     scan_jitter: Option<f64>,
-    /// World: khepera-arena, office or corridor.
+    /// Laser model: urg-04lx, lds (360°, 5 Hz) or sick (180°, clockwise); each sweeps
+    /// its rays (see --no-sweep). Default: the preset's.
+    #[arg(long)]
+    laser: Option<String>,
+    /// Every ray of a scan at the scan's timestamp (no sweep, no
+    /// laser_front_laser_time_increment PARAM).
+    #[arg(long)]
+    no_sweep: bool,
+    /// World: khepera-arena, office, corridor or hall.
     #[arg(long)]
     world: Option<String>,
     /// Trajectory: mixed, straight-only, spin-only or identical-turns.
@@ -201,6 +209,13 @@ fn apply_overrides(c: &mut SimConfig, a: &Args) -> anyhow::Result<()> {
     }
     set(&mut c.seed, a.seed);
     set(&mut c.duration, a.duration);
+    // The model first: the laser settings below refine it.
+    if let Some(name) = &a.laser {
+        c.laser = odocal_sim::LaserConfig::model(name)?;
+    }
+    if a.no_sweep {
+        c.laser.time_increment = 0.0;
+    }
     set(&mut c.robot.r_l, a.r_l);
     set(&mut c.robot.r_r, a.r_r);
     set(&mut c.robot.b, a.b);
@@ -339,9 +354,24 @@ mod tests {
         let mut c = SimConfig::default();
         assert!(apply_overrides(&mut c, &parse("--out x --initial-ticks 5")).is_err());
         let mut c = SimConfig::default();
+        assert!(apply_overrides(&mut c, &parse("--out x --laser velodyne")).is_err());
+        let mut c = SimConfig::default();
         apply_overrides(&mut c, &parse("--out x --b -1")).unwrap();
         assert!(c.validate().is_err());
         assert!(PresetRegistry::builtin().get("k99").is_err());
+    }
+
+    #[test]
+    fn laser_models_and_sweep() {
+        let mut c = PresetRegistry::builtin().get("khepera").unwrap();
+        assert_eq!(c.laser.time_increment, 0.0);
+        apply_overrides(&mut c, &parse("--out x --laser lds --scan-rate 4")).unwrap();
+        assert_eq!((c.laser.num_rays, c.laser.rate_hz), (360, 4.0));
+        assert!(c.laser.time_increment > 0.0);
+        let mut c = PresetRegistry::builtin().get("pioneer").unwrap();
+        assert!(c.laser.time_increment > 0.0);
+        apply_overrides(&mut c, &parse("--out x --no-sweep")).unwrap();
+        assert_eq!(c.laser.time_increment, 0.0);
     }
 
     #[test]

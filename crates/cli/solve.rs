@@ -1,46 +1,19 @@
-//! `odocal solve TUPLES [--trim icra|tro|none] [--no-refine] [--json]`: the six
+//! `odocal solve TUPLES [--trim chi2|icra|tro|none] [--icp-covariance] [--no-refine] [--json]`: the six
 //! parameters, their covariance and the observability report from a tuple file
 //! (the original package's `{T, phi_l, phi_r, sm}` stream, or ours with `sm_cov`
 //! and wheel-speed profiles).
 
+use crate::calibrate::TrimArg;
+use crate::partial_args::PartialArgs;
 use anyhow::Context;
 use odocal_geom::Pose2;
 use odocal_log::{read_tuples, TupleRecord};
 use odocal_solver::{
-    calibrate, Calibration, ProfileSegment, Sample, SigmaEstimate, SolveOptions, Trim, Verdict,
-    PARAMETER_NAMES,
+    calibrate, Calibration, Constraint, Constraints, ProfileSegment, Sample, SigmaEstimate,
+    SolveOptions, Trim, Verdict, PARAMETER_NAMES,
 };
 use serde::Serialize;
 use std::path::PathBuf;
-
-/// Outlier-trimming rule of the command line.
-#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TrimRule {
-    /// ICRA 2008: drop the worst 5 % three times.
-    Icra,
-    /// Original package (T-RO 2013): p = 1 %, 4 rounds, drop above either threshold.
-    Tro,
-    /// Keep every sample.
-    None,
-}
-
-impl TrimRule {
-    fn name(self) -> &'static str {
-        match self {
-            TrimRule::Icra => "icra",
-            TrimRule::Tro => "tro",
-            TrimRule::None => "none",
-        }
-    }
-
-    fn to_trim(self) -> Trim {
-        match self {
-            TrimRule::Icra => Trim::ICRA,
-            TrimRule::Tro => Trim::TRO,
-            TrimRule::None => Trim::None,
-        }
-    }
-}
 
 /// Where the scan-matching σ's are estimated (command line).
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -56,9 +29,15 @@ pub enum SigmaFrom {
 pub struct Args {
     /// Tuple file: a stream of JSON objects {"T", "phi_l", "phi_r", "sm"[, "sm_cov", "profile"]}.
     pub tuples: PathBuf,
-    /// Outlier trimming between closed-form solves.
-    #[arg(long, value_enum, default_value = "tro")]
-    pub trim: TrimRule,
+    /// Outlier trimming between closed-form solves (the same rules and default as
+    /// `calibrate`).
+    #[arg(long, value_enum, default_value = "chi2")]
+    pub trim: TrimArg,
+    /// Weight each sample by its `sm_cov` (the scan matcher's covariance of ŝ) when
+    /// every sample has one. Off by default, as in `calibrate` (`--icp-covariance`
+    /// there), so the two give the same numbers on the same samples.
+    #[arg(long)]
+    pub icp_covariance: bool,
     /// Return the closed form without maximum-likelihood refinement.
     #[arg(long)]
     pub no_refine: bool,
@@ -70,6 +49,8 @@ pub struct Args {
     /// `final` (final estimate and samples; tighter when outliers survive round 1).
     #[arg(long, value_enum, default_value = "first-round")]
     pub sigma: SigmaFrom,
+    #[command(flatten)]
+    pub partial: PartialArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -79,6 +60,7 @@ pub struct Args {
 pub fn sample_from_record(rec: &TupleRecord) -> Sample {
     let mut s = Sample::from_speeds(rec.t, rec.phi_l, rec.phi_r, Pose2::from_array(rec.sm));
     s.sm_cov = rec.sm_cov;
+    s.scan_times = rec.t0.zip(rec.t1).map(|(t0, t1)| [t0, t1]);
     s.profile = rec.profile.as_ref().map(|pieces| {
         pieces
             .iter()
@@ -115,20 +97,34 @@ struct JsonOutput<'a> {
     cost_after: f64,
     reduced_chi2: f64,
     observability: &'a odocal_solver::Observability,
+    /// Per parameter (r_L, r_R, b, l_x, l_y, l_theta): "free", {"held": v} or
+    /// {"prior": {"mean", "sigma"}}.
+    constraints: Constraints,
 }
 
 /// Runs `odocal solve`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let records = read_tuples(&args.tuples)?;
-    let samples: Vec<Sample> = records.iter().map(sample_from_record).collect();
+    let samples: Vec<Sample> = records
+        .iter()
+        .map(|r| {
+            let s = sample_from_record(r);
+            Sample {
+                sm_cov: s.sm_cov.filter(|_| args.icp_covariance),
+                ..s
+            }
+        })
+        .collect();
     let options = SolveOptions {
-        trim: args.trim.to_trim(),
+        trim: args.trim.into(),
         refine: !args.no_refine,
         use_profile: !args.no_profile,
         sigma_from: match args.sigma {
             SigmaFrom::FirstRound => SigmaEstimate::FirstRound,
             SigmaFrom::Final => SigmaEstimate::FinalSet,
         },
+        constraints: args.partial.constraints()?,
+        accept_weak: args.partial.accept_weak,
         ..SolveOptions::default()
     };
     let cal = calibrate(&samples, &options)
@@ -156,6 +152,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             cost_after: cal.cost_after,
             reduced_chi2: cal.reduced_chi2,
             observability: &cal.observability,
+            constraints: options.constraints,
         };
         let mut text = serde_json::to_string_pretty(&out).context("serializing the result")?;
         text.push('\n');
@@ -197,19 +194,21 @@ fn summary(args: &Args, cal: &Calibration, total: usize) -> String {
     );
     let units = ["m", "m", "m", "m", "m", "rad"];
     for (i, rep) in cal.observability.parameters.iter().enumerate() {
-        let mark = match rep.verdict {
-            Verdict::WellDetermined => "",
-            Verdict::Weak | Verdict::NotExcited => "  <--",
+        let mark = match (rep.verdict, rep.constraint) {
+            (_, Constraint::Held(_)) | (Verdict::WellDetermined, _) => "",
+            (Verdict::Weak | Verdict::NotExcited, _) => "  <--",
+        };
+        let status = match rep.constraint {
+            Constraint::Free => rep.verdict.as_str().to_string(),
+            Constraint::Held(_) => "held (--fix)".to_string(),
+            Constraint::Prior { mean, sigma } => {
+                format!("{} (prior {mean} ± {sigma})", rep.verdict.as_str())
+            }
         };
         let _ = writeln!(
             s,
             "  {:<8} = {:>13.8} {:<3} ± {:.2e}  {}{}",
-            PARAMETER_NAMES[i],
-            rep.value,
-            units[i],
-            rep.sigma,
-            rep.verdict.as_str(),
-            mark
+            PARAMETER_NAMES[i], rep.value, units[i], rep.sigma, status, mark
         );
     }
     let _ = writeln!(

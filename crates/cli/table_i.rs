@@ -6,21 +6,17 @@
 //! the log text; print published vs recovered; optionally write `docs/table-i.md`.
 
 use anyhow::Context;
-use odocal_pipeline::sync::TARGET_INTERVAL_S;
 use odocal_pipeline::table_i::{
-    format_j_consistency, format_reproduction, format_summary, j_consistency, read_table_file,
-    read_tro_reference, reproduce_from_text, workspace_reference_dir, workspace_table_path,
-    JConsistency, PublishedRow, Reproduction, Tolerances,
+    format_j_consistency, format_reproduction, format_summary, format_umbmark, j_consistency,
+    read_table, read_tro_reference, reproduce_from_text, row_seed, umbmark_j_consistency,
+    workspace_reference_dir, workspace_table_path, JConsistency, OdometryLine, PublishedRow,
+    PublishedTable, Reproduction, Tolerances,
 };
-use odocal_pipeline::Options;
-use odocal_sim::{simulate, PresetRegistry};
+use odocal_sim::{simulate_table_row, RobotParams};
 use odocal_solver::Params;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// Ticks per wheel revolution of the Khepera III's encoders.
-pub const KHEPERA_TICKS_PER_REV: f64 = 2764.8;
 
 /// Relative tolerance of the J consistency check: printing precision of about four
 /// significant digits.
@@ -43,7 +39,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE")]
     pub table: Option<PathBuf>,
     /// Directory of the T-RO 2013 reference data (`*_results.json`, `*.tuple`);
-    /// default: `../shared/reference` beside the source tree.
+    /// default: `$ODOCAL_REFERENCE_DIR`, else `../shared/reference` beside the source tree.
     #[arg(long, value_name = "DIR")]
     pub reference: Option<PathBuf>,
     /// Base seed of the simulations (each row's seed also depends on its name).
@@ -54,41 +50,35 @@ pub struct Args {
     pub threads: Option<usize>,
 }
 
-/// The simulation seed of a row: `seed` mixed with a hash of the row's name, so a
-/// row gets the same log whichever other rows run.
-pub fn row_seed(seed: u64, name: &str) -> u64 {
-    // FNV-1a.
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in name.bytes() {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    h ^ seed
+/// Simulates a Khepera III with a URG-04LX whose true parameters are `truth`, long
+/// enough for about `samples` pipeline samples at the default stride (the simulator's
+/// Table I row configuration, `odocal_sim::table_row_config`), and returns the log text.
+pub fn simulate_log_text(
+    name: &str,
+    truth: &Params,
+    samples: usize,
+    seed: u64,
+) -> anyhow::Result<Vec<u8>> {
+    let robot = RobotParams {
+        r_l: truth.r_l,
+        r_r: truth.r_r,
+        b: truth.b,
+        laser: truth.laser,
+    };
+    Ok(simulate_table_row(name, &robot, samples as u64, seed)?)
 }
 
-/// Simulates a Khepera III with a URG-04LX whose true parameters are `truth`, long
-/// enough for about `samples` pipeline samples at the default stride, and returns
-/// the log text.
-pub fn simulate_log_text(truth: &Params, samples: usize, seed: u64) -> anyhow::Result<Vec<u8>> {
-    let mut config = PresetRegistry::builtin().get("khepera")?;
-    config.seed = seed;
-    config.robot.r_l = truth.r_l;
-    config.robot.r_r = truth.r_r;
-    config.robot.b = truth.b;
-    config.robot.laser = truth.laser;
-    config.encoder.ticks_per_revolution = KHEPERA_TICKS_PER_REV;
-    let rate = config.laser.rate_hz;
-    let stride = (TARGET_INTERVAL_S * rate).round().max(1.0);
-    config.duration = (samples as f64 + 0.5) * stride / rate;
-    let run = simulate(&config)?;
-    let mut text = Vec::new();
-    run.write_log(&mut text, &[])?;
-    Ok(text)
+/// What `load_rows` found: the rows to run, the Table I file's citation and UMBmark
+/// trials, and notices about missing sources.
+struct Loaded {
+    rows: Vec<PublishedRow>,
+    table: Option<PublishedTable>,
+    notes: Vec<String>,
 }
 
 /// The published rows: the Table I file's, then the T-RO reference's. Missing
 /// sources are skipped with a notice on stderr.
-fn load_rows(args: &Args) -> anyhow::Result<(Vec<PublishedRow>, Vec<String>)> {
+fn load_rows(args: &Args) -> anyhow::Result<Loaded> {
     let mut rows = Vec::new();
     let mut notes = Vec::new();
     let table = match &args.table {
@@ -100,14 +90,21 @@ fn load_rows(args: &Args) -> anyhow::Result<(Vec<PublishedRow>, Vec<String>)> {
         .into_iter()
         .find(|p| p.exists()),
     };
-    match table {
-        Some(path) => rows.extend(read_table_file(&path)?),
-        None => notes.push(
-            "No ICRA 2008 Table I file (fixtures/table-i.json): the published table could not \
-             be retrieved and awaits transcription, so only the T-RO 2013 rows are compared."
-                .to_string(),
-        ),
-    }
+    let table = match table {
+        Some(path) => {
+            let t = read_table(&path)?;
+            rows.extend(t.rows.iter().cloned());
+            Some(t)
+        }
+        None => {
+            notes.push(
+                "No ICRA 2008 Table I file (fixtures/table-i.json here or in the source tree, \
+                 or --table FILE): only the T-RO 2013 rows are compared."
+                    .to_string(),
+            );
+            None
+        }
+    };
     let reference = args
         .reference
         .clone()
@@ -144,7 +141,7 @@ fn load_rows(args: &Args) -> anyhow::Result<(Vec<PublishedRow>, Vec<String>)> {
         }
         rows.retain(|r| args.rows.contains(&r.name));
     }
-    Ok((rows, notes))
+    Ok(Loaded { rows, table, notes })
 }
 
 /// Wall time spent on one row (s).
@@ -152,6 +149,13 @@ struct RowTiming {
     simulate: f64,
     log_mb: f64,
 }
+
+/// Rows whose calibration is compared with the UMBmark trials (ICRA 2008 Table II).
+const UMBMARK_ROWS: [&str; 2] = ["k22-k29", "k40-k45"];
+
+/// Marks the hand-written findings kept by `--write` when it rewrites the document.
+const FINDINGS_BEGIN: &str = "<!-- findings: written by hand, kept by `table-i --write` -->";
+const FINDINGS_END: &str = "<!-- end of findings -->";
 
 /// Runs `odocal table-i`.
 pub fn run(args: Args) -> anyhow::Result<()> {
@@ -161,10 +165,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             args.samples_scale
         );
     }
-    let (rows, notes) = load_rows(&args)?;
+    let Loaded { rows, table, notes } = load_rows(&args)?;
     let pool = crate::input::thread_pool(args.threads)?;
     let tol = Tolerances::default();
-    let opts = Options::default();
+    let opts = odocal_pipeline::table_i::reproduction_options();
     let mut reproductions: Vec<Reproduction> = Vec::new();
     let mut timings = Vec::new();
     let started = Instant::now();
@@ -172,7 +176,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let target = row.scaled_samples(args.samples_scale);
         let seed = row_seed(args.seed, &row.name);
         let t = Instant::now();
-        let text = simulate_log_text(&row.truth(), target, seed)
+        let text = simulate_log_text(&row.name, &row.truth(), target, seed)
             .with_context(|| format!("simulating row '{}'", row.name))?;
         let timing = RowTiming {
             simulate: t.elapsed().as_secs_f64(),
@@ -194,11 +198,23 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if !consistency.is_empty() {
         println!("{}", format_j_consistency(&consistency, J_PRINT_TOLERANCE));
     }
+    let umbmark = table.as_ref().map(|t| umbmark_section(t, &reproductions));
+    if let Some(u) = &umbmark {
+        println!("{u}");
+    }
     let total = started.elapsed().as_secs_f64();
     if let Some(path) = &args.write {
+        let findings = std::fs::read_to_string(path)
+            .ok()
+            .and_then(|old| kept_findings(&old));
         let doc = document(
-            &args,
-            &notes,
+            &Inputs {
+                args: &args,
+                notes: &notes,
+                table: table.as_ref(),
+                umbmark: umbmark.as_deref(),
+                findings: findings.as_deref(),
+            },
             &reproductions,
             &timings,
             &consistency,
@@ -224,7 +240,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 fn timing_line(rep: &Reproduction, t: &RowTiming) -> String {
-    let s = &rep.report.timing_s;
+    let s = &rep.estimate.timing_s;
     format!(
         "time: simulate {:.2} s ({:.1} MB of log), read {:.2} s, sync {:.3} s, match {:.2} s, \
          solve {:.3} s",
@@ -250,11 +266,51 @@ fn command_line(args: &Args) -> String {
     c
 }
 
+/// The UMBmark comparison: the Table II trials beside the published ICRA rows
+/// k22-k29, k40-k45 (radii from J) and what odocal recovered on their presets.
+fn umbmark_section(table: &PublishedTable, reps: &[Reproduction]) -> String {
+    let (mut published, mut ours) = (Vec::new(), Vec::new());
+    for name in UMBMARK_ROWS {
+        if let Some(row) = table.rows.iter().find(|r| r.name == name) {
+            let t = row.truth();
+            published.push(OdometryLine {
+                name: format!("ICRA 2008 Table I, {name} (published, radii from J)"),
+                b: t.b,
+                r_l: t.r_l,
+                r_r: t.r_r,
+            });
+        }
+        if let Some(rep) = reps.iter().find(|r| r.row.name == name) {
+            ours.push(OdometryLine {
+                name: format!("odocal on the {name} preset"),
+                b: rep.estimate.params[2],
+                r_l: rep.estimate.params[0],
+                r_r: rep.estimate.params[1],
+            });
+        }
+    }
+    format_umbmark(&table.umbmark, &published, &ours)
+}
+
+/// The hand-written findings of an earlier document, markers included.
+fn kept_findings(old: &str) -> Option<String> {
+    let begin = old.find(FINDINGS_BEGIN)?;
+    let end = old[begin..].find(FINDINGS_END)? + begin + FINDINGS_END.len();
+    Some(old[begin..end].to_string())
+}
+
+/// What the document says besides the reproductions.
+struct Inputs<'a> {
+    args: &'a Args,
+    notes: &'a [String],
+    table: Option<&'a PublishedTable>,
+    umbmark: Option<&'a str>,
+    findings: Option<&'a str>,
+}
+
 /// The Markdown document `--write` produces.
-#[allow(clippy::too_many_arguments)]
 fn document(
-    args: &Args,
-    notes: &[String],
+    inputs: &Inputs,
     reps: &[Reproduction],
     timings: &[RowTiming],
     consistency: &[JConsistency],
@@ -269,26 +325,40 @@ fn document(
     );
     let _ = writeln!(
         d,
-        "Generated by `{}` (this file is its output; do not edit by hand). Every row is a \
+        "Generated by `{}` (this file is its output; do not edit by hand, except between the \
+         findings markers, which `--write` keeps). Every row is a \
          published calibration: a Khepera III (encoders {} ticks/rev) with a Hokuyo URG-04LX \
          is simulated (`odocal-sim`, Khepera arena, mixed trajectory) with the row's \
          parameters as the truth, for about the row's number of samples at the default \
          stride, and the whole pipeline runs on the log text (read → synchronize → match → \
          solve, default options: encoder profile, T-RO trimming, ML refinement). The \
          recovered parameters are compared with the row.\n",
-        command_line(args),
-        KHEPERA_TICKS_PER_REV
+        command_line(inputs.args),
+        odocal_sim::EncoderConfig::default().ticks_per_revolution
     );
     let _ = writeln!(d, "## Sources\n");
-    let _ = writeln!(
-        d,
-        "- **ICRA 2008 Table I** (rows k07 … k45): `fixtures/table-i.json` when present \
-         (format: `crates/pipeline/src/table_i.rs`). The published table could not be \
-         retrieved where this project was built, so it is not transcribed yet and its \
-         numbers are not invented here. When it is, its `(b, J21, J22)` are authoritative \
-         for the radii (`r_L = −b·J21`, `r_R = b·J22`; the printed `r_L`/`r_R` headings are \
-         swapped, see `docs/method.md`)."
-    );
+    match inputs.table {
+        Some(t) => {
+            let _ = writeln!(
+                d,
+                "- **ICRA 2008 Table I** (rows k07 … k40-k45), from `fixtures/table-i.json`: {} \
+                 The numbers are copied as printed (metres, radians). The printed J columns \
+                 agree with eq. (2) only with the r_L and r_R headings exchanged (section \
+                 *Internal consistency* below), so `(b, J21, J22)` are authoritative for the \
+                 radii: the truth of each simulation is `r_L = −b·J21`, `r_R = b·J22`, the \
+                 printed b and the printed laser pose. The same rows are the simulator's \
+                 presets (`odocal simulate --preset k22-k29`). The table prints no standard \
+                 deviations.",
+                t.citation.as_deref().unwrap_or("(no citation in the file)")
+            );
+        }
+        None => {
+            let _ = writeln!(
+                d,
+                "- **ICRA 2008 Table I**: not found (see the note below)."
+            );
+        }
+    }
     let _ = writeln!(
         d,
         "- **T-RO 2013 package**: the published results of the three real configurations \
@@ -299,7 +369,7 @@ fn document(
          is what odocal reports on the simulated log, whose scan-matching noise is the \
          simulator's, not the real laser's.\n"
     );
-    for n in notes {
+    for n in inputs.notes {
         let _ = writeln!(d, "Note: {n}\n");
     }
     let _ = writeln!(d, "## Rules\n");
@@ -308,10 +378,12 @@ fn document(
         "Every quantity (r_L, r_R, b, ℓx, ℓy, ℓθ and the derived J21 = −r_L/b, \
          J22 = r_R/b) within {}σ of the covariance odocal reports; for runs of at least \
          {} samples also r_L, r_R, b, J21, J22 within {:.2} %, ℓx, ℓy within {:.1} mm and \
-         ℓθ within {:.1}°. The same checks run in `tests/table_i.rs` (quick: about 800 samples per \
-         row, 3σ only; full size: the ignored test `full_size_rows_meet_every_bound`; the \
-         ignored test `three_sigma_rule_holds_over_seeds` measures how often the 3σ rule \
-         holds over 8 seeds, and the RMS of error/σ).\n",
+         ℓθ within {:.1}° (rows published with fewer samples get the 3σ rule only). The \
+         same checks run in `tests/table_i.rs` (quick: every row at up to 600 samples, 3σ \
+         only; full size: the ignored test `full_size_rows_meet_every_bound`; the ignored \
+         test `three_sigma_rule_holds_over_seeds` measures how often the 3σ rule holds over \
+         several seeds, and the RMS of error/σ). The seed of a row is the base seed mixed \
+         with its name; no seed is chosen per row.\n",
         tol.sigma_multiple,
         tol.min_samples_for_bounds,
         tol.relative * 100.0,
@@ -320,6 +392,28 @@ fn document(
     );
     let _ = writeln!(d, "## Summary\n");
     let _ = writeln!(d, "{}", format_summary(reps, tol));
+    let failures: Vec<String> = reps.iter().flat_map(|r| r.failures(tol)).collect();
+    if failures.is_empty() {
+        let _ = writeln!(d, "Every row passes.\n");
+    } else {
+        let _ = writeln!(d, "Checks outside the bounds:\n");
+        for f in &failures {
+            let _ = writeln!(d, "- {f}");
+        }
+        let _ = writeln!(d);
+    }
+    let _ = writeln!(d, "## Findings\n");
+    match inputs.findings {
+        Some(f) => {
+            let _ = writeln!(d, "{f}\n");
+        }
+        None => {
+            let _ = writeln!(
+                d,
+                "{FINDINGS_BEGIN}\n(No findings written yet.)\n{FINDINGS_END}\n"
+            );
+        }
+    }
     let _ = writeln!(d, "## Rows\n");
     for (rep, t) in reps.iter().zip(timings) {
         let _ = writeln!(d, "### {}\n", rep.row.name);
@@ -332,17 +426,12 @@ fn document(
         "J recomputed by eq. (2), `J = [[r_L/2, r_R/2], [−r_L/b, r_R/b]]`, from the printed \
          b and radii, once with the headings as printed and once with r_L and r_R exchanged, \
          against the printed J columns (`j_consistency` in `crates/pipeline/src/table_i.rs`; \
-         test `published_j_columns_reveal_the_heading_swap`)."
+         test `published_j_columns_reveal_the_heading_swap`). `Ambiguous`: the two radii are \
+         equal to printing precision, so both readings fit. The printed values have five \
+         decimals, so deviations up to about 1e-4 (relative 1e-3) are rounding."
     );
     if consistency.is_empty() {
-        let _ = writeln!(
-            d,
-            "\n**Awaits the ICRA 2008 Table I**: none of the rows above prints J columns (the \
-             T-RO package publishes radii and b only), so there is nothing to check yet. \
-             `docs/method.md` states that in every row of the ICRA table the printed J \
-             satisfies `J11 = r_R/2`, `J21 = −r_R/b`, `J22 = r_L/b`, i.e. the reading \
-             `HeadingsSwapped`; the test asserts exactly that once the table is transcribed."
-        );
+        let _ = writeln!(d, "\nNone of the rows above prints J columns.");
     } else {
         let _ = writeln!(
             d,
@@ -350,16 +439,61 @@ fn document(
             format_j_consistency(consistency, J_PRINT_TOLERANCE)
         );
     }
-    let _ = writeln!(d, "\n## Machine\n");
+    if let (Some(t), Some(u)) = (inputs.table, inputs.umbmark) {
+        let _ = writeln!(d, "\n## Table II: UMBmark beside the calibration\n");
+        let _ = writeln!(
+            d,
+            "The paper's Table II calibrates the same robot with UMBmark (square paths \
+             measured with a ceiling camera){}. UMBmark observes only the ratios b/r̄ and \
+             r_R/r_L: as the paper remarks, it fixes the mean radius at the nominal 21 mm, \
+             so its b and radii are scaled by 21 mm / r̄ against a calibration that measures \
+             r̄ (column r̄ below), and only the ratio \
+             columns (b/r̄, r_R/r_L, and J up to the same scale) can be compared. Below: \
+             every trial, the published k22-k29 and k40-k45 rows (radii from J), and what \
+             odocal recovers on the simulated presets of those two rows (full size, seed as \
+             above). No test asserts this table; it is for reading.\n",
+            t.umbmark_note
+                .as_deref()
+                .map(|n| format!(" (the file's note: {n})"))
+                .unwrap_or_default()
+        );
+        let _ = writeln!(d, "{u}");
+        let trial_checks: Vec<JConsistency> = t
+            .umbmark
+            .iter()
+            .filter_map(|tr| umbmark_j_consistency(tr, J_PRINT_TOLERANCE))
+            .collect();
+        if !trial_checks.is_empty() {
+            let _ = writeln!(
+                d,
+                "\nThe Table II J columns by eq. (2) (unlike Table I, they agree with the \
+                 headings as printed):\n\n{}",
+                format_j_consistency(&trial_checks, J_PRINT_TOLERANCE)
+            );
+        }
+    }
+    let _ = writeln!(d, "\n## Machine and time\n");
+    let sum = |f: &dyn Fn(&Reproduction, &RowTiming) -> f64| -> f64 {
+        reps.iter().zip(timings).map(|(r, t)| f(r, t)).sum()
+    };
+    let samples: usize = reps.iter().map(|r| r.target_samples).sum();
     let _ = writeln!(
         d,
-        "{} row(s) in {:.1} s wall with {} scan-matching thread(s) on {} ({} cores, \
-         release build).",
+        "{} row(s), {} samples simulated, in {:.1} s wall with {} scan-matching thread(s) on {} \
+         ({} cores, release build): simulate {:.1} s ({:.0} MB of log text), read {:.1} s, \
+         synchronize {:.2} s, match {:.1} s, solve {:.2} s.",
         reps.len(),
+        samples,
         total_s,
         threads,
         cpu_model(),
-        std::thread::available_parallelism().map_or(0, |n| n.get())
+        std::thread::available_parallelism().map_or(0, |n| n.get()),
+        sum(&|_, t| t.simulate),
+        sum(&|_, t| t.log_mb),
+        sum(&|r, _| r.estimate.timing_s.parse),
+        sum(&|r, _| r.estimate.timing_s.sync),
+        sum(&|r, _| r.estimate.timing_s.r#match),
+        sum(&|r, _| r.estimate.timing_s.solve),
     );
     d
 }

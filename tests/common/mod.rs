@@ -2,6 +2,8 @@
 
 #![allow(dead_code)]
 
+pub mod accuracy;
+
 use odocal_sim::{simulate, SimConfig};
 use std::fs::File;
 use std::io::BufWriter;
@@ -47,4 +49,17 @@ pub fn cleanup(path: &Path) {
     if let Some(dir) = path.parent() {
         let _ = std::fs::remove_dir_all(dir);
     }
+}
+
+/// Runs the `odocal` binary with `args`.
+pub fn odocal(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_odocal"))
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// A run's standard error as text.
+pub fn stderr(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
 }

@@ -62,4 +62,33 @@ pub enum IcpError {
         /// [`crate::IcpParams::max_angular_correction`].
         max_angular: f64,
     },
+    /// The iterations settled where the residuals are far above the noise the scans
+    /// show themselves: a wrong local minimum, not a match.
+    #[error("residuals inconsistent with the scans' noise: spread {spread_mm:.2} mm is {ratio:.1}x the scans' own noise {noise_mm:.2} mm (at most {max_ratio}x allowed): a wrong alignment")]
+    ResidualAboveNoise {
+        /// Robust residual spread at the result (mm).
+        spread_mm: f64,
+        /// Range noise the scans show about their own local lines (mm).
+        noise_mm: f64,
+        /// `spread_mm / noise_mm`.
+        ratio: f64,
+        /// [`crate::IcpParams::max_residual_to_noise`].
+        max_ratio: f64,
+    },
+    /// The result explains too small a part of the current scan.
+    #[error("only {share_percent:.0} % of the current scan's points match the reference at the result (at least {min_percent:.0} % needed): too little overlap or a wrong alignment")]
+    SmallOverlap {
+        /// Share of the valid points used (%).
+        share_percent: f64,
+        /// [`crate::IcpParams::min_matched_share`] (%).
+        min_percent: f64,
+    },
+    /// Starting points far apart reached different, equally consistent results.
+    #[error("ambiguous: two consistent alignments {apart_m:.3} m and {apart_deg:.1}° apart (repeated structure); no result chosen")]
+    Ambiguous {
+        /// Translation between the two results (m).
+        apart_m: f64,
+        /// Rotation between the two results (°).
+        apart_deg: f64,
+    },
 }

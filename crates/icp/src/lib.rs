@@ -35,6 +35,13 @@
 //!    `max_condition_number`, e.g. a corridor) steps are not taken: the result keeps
 //!    the first guess there and is flagged `ill_conditioned`. A result too far from
 //!    the first guess, NaN, or too few matches is an [`IcpError`].
+//! 7. `consistency`: a result whose residual spread is far above the range noise the
+//!    two scans show themselves, or that uses too few of the current scan's points,
+//!    is a wrong local minimum and is refused.
+//! 8. `rotation_search`: when the attempt from the first guess fails or is refused,
+//!    the matcher starts again from the rotations where the two scans' histograms of
+//!    line directions agree best (translation-independent); two distinct consistent
+//!    results are refused as ambiguous.
 //!
 //! ```no_run
 //! use odocal_icp::{IcpParams, Matcher, PreparedScan};
@@ -50,12 +57,14 @@
 
 #![deny(missing_docs)]
 
+mod consistency;
 mod correspondence;
 mod covariance;
 mod error;
 mod matcher;
 mod params;
 mod preprocess;
+mod rotation_search;
 mod solve_step;
 mod trimming;
 

@@ -1,7 +1,9 @@
 //! The ICP loop: correspondences, trimming, exact step, until the estimate settles.
 
+use crate::consistency::{check_consistency, robust_spread, scans_noise};
 use crate::correspondence::{nearest_by_angle, nearest_by_tree, segment_for};
 use crate::covariance::{conditioning, InformationSum, RayResiduals};
+use crate::rotation_search::candidate_rotations;
 use crate::solve_step::NormalEquations;
 use crate::trimming::threshold;
 use crate::{IcpError, IcpParams, NeighbourSearch, PreparedScan};
@@ -54,6 +56,16 @@ pub struct IcpResult {
     /// Unit vector `(x, y, ρ·θ)` of the least constrained direction (ρ: RMS range of
     /// the used points).
     pub weakest_direction: [f64; 3],
+    /// Robust spread (1.4826 × median absolute weighted residual, m for a head-on ray)
+    /// over every correspondence within the gate at the result, trimmed or not.
+    pub residual_spread: f64,
+    /// Range noise the two scans show themselves (the larger of the two; m), with a
+    /// floor for exact data; see [`IcpParams::max_residual_to_noise`].
+    pub noise_sigma: f64,
+    /// Share of the current scan's valid points used in the final step.
+    pub matched_share: f64,
+    /// Starting points tried: 1 when the first guess led to the result.
+    pub starts: u32,
 }
 
 /// One used-or-not correspondence of the current iteration.
@@ -87,6 +99,13 @@ const MAX_PREDICTION_RATIO: f64 = 0.5;
 /// own standard deviation moves a point at 4 m by ≈ 1.5 mm, i.e. 0.5 σ̂: stopping
 /// there adds < 0.5 % to the RMS error; measured: no change beyond ±0.3 %).
 const PREDICTED_MOTION_SHARE: f64 = 0.03;
+
+/// A candidate rotation this close to the first guess's (rad) is not tried again.
+const SAME_START_THETA: f64 = 0.035;
+/// Two consistent results farther apart than this (m) …
+const DISTINCT_XY: f64 = 0.02;
+/// … or this (rad) are different alignments: the pair is ambiguous.
+const DISTINCT_THETA: f64 = 0.0175;
 
 /// Number of past correspondence sets remembered to detect a cycle.
 const CYCLE_MEMORY: usize = 8;
@@ -126,6 +145,14 @@ impl Matcher {
 
     /// Estimates ŝ, the pose of `current`'s sensor in `reference`'s sensor frame,
     /// starting from `first_guess` (e.g. from odometry).
+    ///
+    /// When the iterations from the first guess fail or end in a result the
+    /// consistency test refuses (residuals far above the scans' own noise, or too few
+    /// points matched), they are run again from up to
+    /// [`IcpParams::rotation_hypotheses`] other rotations (where the scans' line
+    /// directions agree best); the consistent result is returned, an
+    /// [`IcpError::Ambiguous`] when two distinct consistent results are found, and the
+    /// first attempt's error when none is.
     pub fn match_scans(
         &mut self,
         reference: &PreparedScan,
@@ -145,6 +172,73 @@ impl Matcher {
                     .to_string(),
             ));
         }
+        let first_error = match self.refine(
+            reference,
+            current,
+            first_guess,
+            first_guess,
+            &params,
+            use_tree,
+        ) {
+            Ok(result) => return Ok(result),
+            Err(e) => e,
+        };
+        let candidates = candidate_rotations(
+            reference,
+            current,
+            first_guess.theta,
+            params.max_angular_correction,
+            params.rotation_hypotheses + 1,
+        );
+        let mut found: Option<IcpResult> = None;
+        let mut starts = 1;
+        for theta in candidates
+            .into_iter()
+            .filter(|t| (t - first_guess.theta).abs() > SAME_START_THETA)
+            .take(params.rotation_hypotheses)
+        {
+            starts += 1;
+            let start = Pose2::new(first_guess.x, first_guess.y, theta);
+            let Ok(result) = self.refine(reference, current, start, first_guess, &params, use_tree)
+            else {
+                continue;
+            };
+            found = match found {
+                None => Some(result),
+                Some(best) => {
+                    let apart = best.pose.between(&result.pose);
+                    let apart_theta = wrap_angle(apart.theta).abs();
+                    if apart.translation_norm() > DISTINCT_XY || apart_theta > DISTINCT_THETA {
+                        return Err(IcpError::Ambiguous {
+                            apart_m: apart.translation_norm(),
+                            apart_deg: apart_theta.to_degrees(),
+                        });
+                    }
+                    Some(if result.matched_share > best.matched_share {
+                        result
+                    } else {
+                        best
+                    })
+                }
+            };
+        }
+        match found {
+            Some(result) => Ok(IcpResult { starts, ..result }),
+            None => Err(first_error),
+        }
+    }
+
+    /// The ICP iterations from `start`, the corrections measured from `anchor` (the
+    /// caller's first guess), and the consistency test of the result.
+    fn refine(
+        &mut self,
+        reference: &PreparedScan,
+        current: &PreparedScan,
+        start: Pose2,
+        anchor: Pose2,
+        params: &IcpParams,
+        use_tree: bool,
+    ) -> Result<IcpResult, IcpError> {
         let gate2 = params.max_correspondence_dist * params.max_correspondence_dist;
         let rho_max = current.max_valid_range;
 
@@ -157,7 +251,7 @@ impl Matcher {
         match (reference.uniform, current.uniform) {
             // Same ray geometry: the guess is a shift of the ray index.
             (Some(r), Some(c)) if r == c => {
-                let shift = (first_guess.theta / r.1).round();
+                let shift = (start.theta / r.1).round();
                 let last = reference.len() as f64 - 1.0;
                 self.search_start.extend(
                     current
@@ -168,14 +262,14 @@ impl Matcher {
             }
             _ => {
                 for &i in &current.valid_indices {
-                    let bearing = current.angles[i as usize] + first_guess.theta;
+                    let bearing = current.angles[i as usize] + start.theta;
                     self.search_start
                         .push(reference.ray_near_bearing(bearing) as u32);
                 }
             }
         }
 
-        let mut estimate = first_guess;
+        let mut estimate = start;
         let mut previous_motion: Option<f64> = None;
         let mut tau = f64::INFINITY;
         let mut iterations = 0;
@@ -207,7 +301,7 @@ impl Matcher {
             };
             let (motion_limited, noise_tau);
             (tau, motion_limited, noise_tau) =
-                threshold(&mut self.squared_residuals, &params, motion, tau);
+                threshold(&mut self.squared_residuals, params, motion, tau);
             let noise_tau_sq = noise_tau * noise_tau;
             // Tilt-noise scale of the reference lines, for the errors-in-variables
             // correction (0 on noise-free scans).
@@ -333,14 +427,14 @@ impl Matcher {
                 break;
             }
             // Hopelessly far: stop early (the final check reports it).
-            let off = first_guess.between(&estimate);
+            let off = anchor.between(&estimate);
             if off.translation_norm() > 3.0 * params.max_linear_correction
                 || off.theta.abs() > 3.0 * params.max_angular_correction
             {
                 break;
             }
         }
-        let correction = first_guess.between(&estimate);
+        let correction = anchor.between(&estimate);
         let (linear, angular) = (
             correction.translation_norm(),
             wrap_angle(correction.theta).abs(),
@@ -361,21 +455,23 @@ impl Matcher {
             });
         }
 
-        // Uncertainty at the final estimate, over the correspondences used last.
+        // Uncertainty at the final estimate, over the correspondences used last; the
+        // residual spread over all of them (used or not) for the consistency test.
         let tau_sq = tau * tau;
         let mut info = InformationSum::new(&estimate, current.len(), &mut self.ray_residuals);
         let (s, c) = estimate.theta.sin_cos();
         let mut sum_abs = 0.0;
-        for k in self
-            .correspondences
-            .iter()
-            .filter(|k| k.normalized_sq <= tau_sq)
-        {
+        self.squared_residuals.clear();
+        for k in &self.correspondences {
             let p = [
                 estimate.x + c * k.q[0] - s * k.q[1],
                 estimate.y + s * k.q[0] + c * k.q[1],
             ];
             let e = k.normal[0] * p[0] + k.normal[1] * p[1] - k.offset;
+            self.squared_residuals.push(e * e * k.weight);
+            if k.normalized_sq > tau_sq {
+                continue;
+            }
             sum_abs += e.abs();
             info.add(
                 current.valid_indices[(k.key >> 32) as usize] as usize,
@@ -390,7 +486,7 @@ impl Matcher {
             iteration: iterations,
             what: "non-finite information matrix",
         })?;
-        Ok(IcpResult {
+        let result = IcpResult {
             pose: estimate,
             covariance: unc.covariance,
             iterations,
@@ -402,7 +498,13 @@ impl Matcher {
             ill_conditioned: unc.condition_number.is_nan()
                 || unc.condition_number > params.max_condition_number,
             weakest_direction: unc.weakest_direction,
-        })
+            residual_spread: robust_spread(&mut self.squared_residuals),
+            noise_sigma: scans_noise(reference, current),
+            matched_share: used as f64 / current.valid_count().max(1) as f64,
+            starts: 1,
+        };
+        check_consistency(&result, params)?;
+        Ok(result)
     }
 
     /// Fills `self.correspondences` for the estimate.

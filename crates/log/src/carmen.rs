@@ -6,8 +6,10 @@
 
 use crate::builder::{LogBuilder, Stream};
 use crate::error::LogError;
+use crate::line_reader::{read_line, Line, MAX_LINE_BYTES};
 use crate::model::{LaserFields, Log, OdomRecord, ScanGeometry, ScanKind, ValueSource};
 use crate::options::{is_valid_modulus, ReadOptions};
+use crate::printable::printable;
 use crate::tokens::{FieldError, Fields, Tokens};
 use odocal_geom::Pose2;
 use std::io::BufRead;
@@ -54,6 +56,12 @@ impl Message {
     }
 }
 
+/// Distinct unknown message names kept; further ones are counted under
+/// [`OTHER_UNKNOWN`].
+const MAX_UNKNOWN_NAMES: usize = 100;
+/// The name under which unknown messages beyond [`MAX_UNKNOWN_NAMES`] are counted.
+const OTHER_UNKNOWN: &str = "(other names)";
+
 /// Parser state across lines.
 struct CarmenReader<'o> {
     b: LogBuilder<'o>,
@@ -90,15 +98,38 @@ pub fn read_carmen_from<R: BufRead>(
     let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
     let mut line_no: u64 = 0;
     loop {
-        buf.clear();
-        let n = reader
-            .read_until(b'\n', &mut buf)
-            .map_err(|e| LogError::io(name, e))?;
-        if n == 0 {
+        let read = read_line(&mut reader, &mut buf).map_err(|e| LogError::io(name, e))?;
+        if read == Line::End {
             break;
         }
         line_no += 1;
-        r.line(&buf, line_no)?;
+        match read {
+            Line::Nul(column) => {
+                return Err(LogError::NotText {
+                    file: name.to_string(),
+                    line: line_no,
+                    detail: format!(
+                        "a NUL byte at column {} (binary data; expected Carmen-style text \
+                         or a JSON log)",
+                        column + 1
+                    ),
+                })
+            }
+            Line::TooLong => {
+                let head = printable(&buf[..buf.len().min(40)], 20);
+                let err = LogError::parse(
+                    name,
+                    line_no,
+                    "line",
+                    format!(
+                        "expected a line of at most {MAX_LINE_BYTES} bytes, found a longer \
+                         one starting `{head}`"
+                    ),
+                );
+                r.b.reject(err)?;
+            }
+            _ => r.line(&buf, line_no)?,
+        }
     }
     r.b.log.stats.lines = line_no;
     for (k, (_, msg)) in MESSAGES.iter().enumerate() {
@@ -123,13 +154,11 @@ impl CarmenReader<'_> {
         }
         let Some(msg) = Message::from_name(first) else {
             let unknown = &mut self.b.log.stats.unknown;
-            let name = String::from_utf8_lossy(first);
-            match unknown.get_mut(name.as_ref()) {
-                Some(c) => *c += 1,
-                None => {
-                    unknown.insert(name.into_owned(), 1);
-                }
+            let mut name = printable(first, 40);
+            if !unknown.contains_key(&name) && unknown.len() >= MAX_UNKNOWN_NAMES {
+                name = OTHER_UNKNOWN.to_string();
             }
+            *unknown.entry(name).or_insert(0) += 1;
             return Ok(());
         };
         let mut f = Fields { tokens };
@@ -230,8 +259,8 @@ impl CarmenReader<'_> {
             _ => {}
         }
         let params = &mut self.b.log.params;
-        let name = String::from_utf8_lossy(name).into_owned();
-        let value = String::from_utf8_lossy(value_token).into_owned();
+        let name = printable(name, 80);
+        let value = printable(value_token, 80);
         params.all.insert(name, value);
         Ok(())
     }

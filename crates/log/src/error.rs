@@ -18,6 +18,16 @@ pub enum LogError {
         /// What was expected and what was found.
         expected: String,
     },
+    /// The input is not a text log (NUL bytes: a binary file, `/dev/zero`, …).
+    #[error("{file}:{line}: not a text log: {detail}")]
+    NotText {
+        /// The file (or stream name).
+        file: String,
+        /// 1-based line where the binary data were found.
+        line: u64,
+        /// What was found (e.g. a NUL byte at a column).
+        detail: String,
+    },
     /// Reading or writing failed at the operating-system level.
     ///
     /// The OS error is part of the message (not a separate `source`), so that error
@@ -112,7 +122,7 @@ impl LogError {
     /// The 1-based line number, for parse errors.
     pub fn line(&self) -> Option<u64> {
         match self {
-            LogError::Parse { line, .. } => Some(*line),
+            LogError::Parse { line, .. } | LogError::NotText { line, .. } => Some(*line),
             _ => None,
         }
     }

@@ -2,13 +2,16 @@
 //! follow each other with optional whitespace, and several may share one line.
 
 use crate::error::LogError;
+use crate::line_reader::MAX_LINE_BYTES;
 use serde::de::DeserializeOwned;
 use std::cell::RefCell;
 use std::io::Read;
 use std::rc::Rc;
 
 /// A reader that remembers where each `\n` is, so that a byte offset reported by the
-/// JSON stream can be turned into a 1-based line number.
+/// JSON stream can be turned into a 1-based line number. It also bounds memory as the
+/// text reader does: a NUL byte (binary data) or a line longer than
+/// [`MAX_LINE_BYTES`] stops the stream with an error.
 struct NewlineTracker<R> {
     inner: R,
     consumed: u64,
@@ -20,8 +23,23 @@ impl<R: Read> Read for NewlineTracker<R> {
         let n = self.inner.read(buf)?;
         let mut newlines = self.newlines.borrow_mut();
         for (i, &b) in buf[..n].iter().enumerate() {
+            let at = self.consumed + i as u64;
             if b == b'\n' {
-                newlines.push(self.consumed + i as u64);
+                newlines.push(at);
+                continue;
+            }
+            if b == 0 {
+                return Err(std::io::Error::other(format!(
+                    "line {}: not a text log: a NUL byte (binary data)",
+                    newlines.len() + 1
+                )));
+            }
+            let line_start = newlines.last().map_or(0, |&nl| nl + 1);
+            if at - line_start >= MAX_LINE_BYTES as u64 {
+                return Err(std::io::Error::other(format!(
+                    "line {}: expected a line of at most {MAX_LINE_BYTES} bytes",
+                    newlines.len() + 1
+                )));
             }
         }
         self.consumed += n as u64;
@@ -86,6 +104,29 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nul_bytes_and_endless_lines_stop_the_stream() {
+        let r = for_each_object::<serde_json::Value, _, _>(
+            &b"{\"a\": 1}\n{\"b\": \0}"[..],
+            "j",
+            "JSON",
+            "an object",
+            |_, _| Ok(()),
+        );
+        let e = r.unwrap_err().to_string();
+        assert!(e.contains("line 2: not a text log"), "{e}");
+        let mut long = b"[".to_vec();
+        long.extend(std::iter::repeat_n(b' ', MAX_LINE_BYTES + 10));
+        let r = for_each_object::<serde_json::Value, _, _>(
+            &long[..],
+            "j",
+            "JSON",
+            "an object",
+            |_, _| Ok(()),
+        );
+        assert!(r.unwrap_err().to_string().contains("at most"));
+    }
 
     #[test]
     fn line_of_counts_newlines_before_the_offset() {

@@ -17,9 +17,11 @@ mod carmen;
 mod error;
 mod json_log;
 mod json_stream;
+mod line_reader;
 mod model;
 mod number;
 mod options;
+mod printable;
 mod read;
 mod summary;
 mod tokens;
@@ -30,10 +32,13 @@ mod writer;
 pub use carmen::read_carmen_from;
 pub use error::{LogError, MissingData};
 pub use json_log::read_json_log_from;
+pub use line_reader::MAX_LINE_BYTES;
 pub use model::*;
 pub use options::{Mode, ReadOptions};
+pub use printable::printable;
 pub use read::{detect_format, read_log, LogFormat};
 pub use summary::{GeometrySummary, LogSummary, SkippedLine};
+pub use tokens::MAX_COUNT;
 pub use tuple::{read_tuples, read_tuples_from, write_tuple, TupleRecord};
 pub use wheel_angles::{
     encoders_from_odometry, ticks_of_angle, wheel_rotations, NominalWheels,

@@ -29,12 +29,30 @@ pub fn detect_format<R: BufRead>(reader: &mut R) -> std::io::Result<LogFormat> {
     })
 }
 
+/// Fails fast, before any parsing, when the start of the input holds a NUL byte: a
+/// binary file or `/dev/zero` is not a text log.
+fn refuse_binary<R: BufRead>(reader: &mut R, name: &str) -> Result<(), LogError> {
+    let buf = reader.fill_buf().map_err(|e| LogError::io(name, e))?;
+    match buf.iter().position(|&b| b == 0) {
+        None => Ok(()),
+        Some(i) => Err(LogError::NotText {
+            file: name.to_string(),
+            line: buf[..i].iter().filter(|&&b| b == b'\n').count() as u64 + 1,
+            detail: format!(
+                "a NUL byte at byte {} (binary data; expected Carmen-style text or a JSON log)",
+                i + 1
+            ),
+        }),
+    }
+}
+
 /// Reads a log file, Carmen-style text or the original package's JSON log.
 pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<Log, LogError> {
     let name = path.display().to_string();
     let file = File::open(path).map_err(|e| LogError::io(&name, e))?;
     let mut reader = BufReader::with_capacity(1 << 18, file);
     let format = detect_format(&mut reader).map_err(|e| LogError::io(&name, e))?;
+    refuse_binary(&mut reader, &name)?;
     match format {
         LogFormat::Carmen => read_carmen_from(reader, &name, opts),
         LogFormat::Json => read_json_log_from(reader, &name, opts),

@@ -3,6 +3,9 @@
 
 use crate::number::{parse_f32, parse_f64, parse_i64};
 
+/// The largest count of readings (or remissions) one line may announce.
+pub const MAX_COUNT: usize = 200_000;
+
 /// True for the bytes that separate tokens: space, tab, the line end, form feeds.
 #[inline]
 fn is_separator(b: u8) -> bool {
@@ -61,14 +64,7 @@ impl FieldError {
     pub(crate) fn new(expected: impl Into<String>, found: Option<&[u8]>) -> Self {
         FieldError {
             expected: expected.into(),
-            found: found.map(|t| {
-                let t = String::from_utf8_lossy(t);
-                if t.chars().count() > 40 {
-                    format!("`{}…`", t.chars().take(40).collect::<String>())
-                } else {
-                    format!("`{t}`")
-                }
-            }),
+            found: found.map(|t| format!("`{}`", crate::printable::printable(t, 40))),
         }
     }
 
@@ -142,12 +138,15 @@ impl<'a> Fields<'a> {
         i32::try_from(v).map_err(|_| FieldError::new(format!("{what} (a 32-bit integer)"), t))
     }
 
-    /// A count (non-negative integer).
+    /// A count (non-negative integer, at most [`MAX_COUNT`]).
     #[inline]
     pub(crate) fn count(&mut self, what: &str) -> Result<usize, FieldError> {
         let t = self.tokens.clone().next();
         let v = self.i64(what)?;
-        usize::try_from(v).map_err(|_| FieldError::new(format!("{what} (a count ≥ 0)"), t))
+        usize::try_from(v)
+            .ok()
+            .filter(|&n| n <= MAX_COUNT)
+            .ok_or_else(|| FieldError::new(format!("{what} (a count from 0 to {MAX_COUNT})"), t))
     }
 
     /// Nothing more on the line.

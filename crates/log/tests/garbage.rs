@@ -58,6 +58,17 @@ proptest! {
         let end = if crlf { "\r\n" } else { "\n" };
         let text: String = lines.iter().map(|l| format!("{l}{end}")).collect();
         let n_lines = text.matches('\n').count() as u64;
+        if let Some(nul) = text.find('\0') {
+            // Binary data is refused even in lenient mode, at the line holding the
+            // first NUL (strict mode may stop earlier, at a malformed line).
+            let line = text[..nul].matches('\n').count() as u64 + 1;
+            let e = read_carmen_from(text.as_bytes(), "g", &ReadOptions::lenient()).unwrap_err();
+            prop_assert!(e.to_string().contains("not a text log"), "{}", e);
+            prop_assert_eq!(e.line(), Some(line));
+            let e = read_carmen_from(text.as_bytes(), "g", &ReadOptions::default()).unwrap_err();
+            prop_assert!(e.line().is_some_and(|l| l <= line));
+            return Ok(());
+        }
 
         let log = read_carmen_from(text.as_bytes(), "g", &ReadOptions::lenient()).unwrap();
         let accepted: u64 = log.stats.messages.values().sum();

@@ -32,7 +32,9 @@ pub enum PipelineError {
     /// The solver returned numbers, but some parameters are so poorly determined
     /// (verdict "weak" or "not excited") that they would mislead.
     #[error(
-        "the data do not determine {} well enough: {sentence} (pass --accept-weak to see the numbers anyway)",
+        "the data do not determine {} well enough: {sentence} (if some of them are known, hold \
+         them with --fix NAME=VALUE or give a prior with --prior NAME=VALUE±SIGMA, SI units; \
+         pass --accept-weak to see the numbers anyway)",
         parameters.join(", ")
     )]
     NotDetermined {
@@ -41,9 +43,55 @@ pub enum PipelineError {
         /// The solver's observability sentence: what motion is missing.
         sentence: String,
     },
+    /// Calibration failed, and the data-health stage found faults in the log that
+    /// explain it: the faults come first, then what failed.
+    #[error("the log has data faults: {faults}; as a result, {cause}")]
+    DataFault {
+        /// The faults found (the warnings' messages, joined).
+        faults: String,
+        /// What failed, without the generic advice.
+        cause: String,
+        /// The underlying refusal.
+        refusal: Box<PipelineError>,
+    },
     /// A setting is out of range.
     #[error("invalid setting: {0}")]
     InvalidSetting(String),
+}
+
+impl PipelineError {
+    /// Names the data faults found in front of a refusal (not enough samples, not
+    /// determined, the solver's refusals) when there are any; other errors unchanged.
+    pub fn with_faults(self, findings: &[crate::health::Finding]) -> Self {
+        let refusal = matches!(
+            self,
+            PipelineError::TooFewSamples { .. }
+                | PipelineError::NotDetermined { .. }
+                | PipelineError::Solve(_)
+                | PipelineError::Log(LogError::MissingData { .. })
+        );
+        let Some(faults) = crate::health::explain(findings).filter(|_| refusal) else {
+            return self;
+        };
+        let cause = match &self {
+            PipelineError::TooFewSamples {
+                usable,
+                pairs,
+                needed,
+                discarded,
+            } => format!(
+                "only {usable} usable sample(s) remain out of {pairs} scan pairs (discarded: \
+                 {}; at least {needed} are needed)",
+                describe_discards(discarded)
+            ),
+            other => other.to_string(),
+        };
+        PipelineError::DataFault {
+            faults,
+            cause,
+            refusal: Box::new(self),
+        }
+    }
 }
 
 fn describe_discards(d: &DiscardCounts) -> String {

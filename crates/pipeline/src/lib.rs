@@ -1,40 +1,48 @@
 //! From a raw log to calibrated parameters: synchronization of the encoder and scan
-//! streams, parallel scan matching, (clock-offset estimation,) solving, and the report.
+//! streams, parallel scan matching, (clock-offset estimation,) solving. The report
+//! (summary, results.json, figures) is the `odocal-report` crate's.
 //!
 //! ```no_run
-//! use odocal_pipeline::{build_report, calibrate_log, NoProgress, Options};
+//! use odocal_pipeline::{calibrate_log, Estimate, NoProgress, Options};
 //! # fn demo() -> Result<(), Box<dyn std::error::Error>> {
 //! let path = std::path::Path::new("robot.log");
 //! let log = odocal_log::read_log(path, &odocal_log::ReadOptions::default())?;
 //! let outcome = calibrate_log(&log, &Options::default(), &NoProgress)?;
-//! println!("{}", build_report(path, &log, &Options::default(), &outcome));
+//! println!("{:?}", Estimate::of(&outcome).values());
 //! # Ok(()) }
 //! ```
 //!
 //! Stages, one module each: [`sync`] (encoder interpolation at the scan timestamps,
-//! encoder profile, discards by reason), [`matching`] (ICP over the pairs, in parallel
-//! with [`parallel`]), [`time_offset`] (optional clock-offset search), [`run`] (the
-//! whole, with timing), [`report`] and [`output`] (results.json, tuples, figures).
+//! encoder profile, discards by reason), [`sweep`] (rays of a sweeping laser moved to
+//! the sensor frame at the scan's reference time), [`matching`] (ICP over the pairs, in
+//! parallel with [`parallel`]), [`health`] (data faults found, repaired and named,
+//! before and after matching), [`time_offset`] (optional clock-offset search), [`run`] (the
+//! whole, with timing), [`samples`] (the samples and their tuples), [`estimate`] (the
+//! core numbers of a result).
 
 #![deny(missing_docs)]
 
+pub mod atomic_file;
+pub mod consistency;
 mod error;
+pub mod estimate;
+pub mod health;
 pub mod matching;
-pub mod output;
 pub mod parallel;
 mod progress;
-pub mod report;
 pub mod run;
 pub mod samples;
-pub mod svg;
+pub mod sweep;
 pub mod sync;
 /// Regression against published calibration results (ICRA 2008 Table I, T-RO 2013).
 pub mod table_i;
 pub mod time_offset;
 
+pub use atomic_file::{write_atomically, write_bytes_atomically};
 pub use error::PipelineError;
+pub use estimate::Estimate;
+pub use health::{FaultKind, Finding, Severity};
 pub use odocal_solver::Trim;
-pub use output::{write_outputs, write_tuples};
 pub use progress::{NoProgress, Progress};
-pub use report::{build_report, Report};
 pub use run::{calibrate_log, synchronize_and_match, Options, Outcome, Synchronized, Timing};
+pub use samples::write_tuples;

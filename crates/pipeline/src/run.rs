@@ -1,9 +1,12 @@
 //! The whole pipeline: synchronize, match, (estimate the clock offset,) solve.
 
+use crate::consistency::{check_halves, Consistency};
 use crate::error::PipelineError;
+use crate::health::{self, FaultKind, Finding, Severity};
 use crate::matching::{match_pairs, MatchStats};
 use crate::progress::Progress;
 use crate::samples::PairSample;
+use crate::sweep::{compensated_pairs, has_sweep, reference_time};
 use crate::sync::{
     default_stride, scan_pairs, DiscardCounts, DiscardReason, EncoderTrack, ScanPair, SyncLimits,
     WheelMotion,
@@ -11,12 +14,14 @@ use crate::sync::{
 use crate::time_offset::{estimate_time_offset, OffsetEstimate};
 use odocal_geom::Pose2;
 use odocal_icp::IcpParams;
-use odocal_log::Log;
+use odocal_log::{Log, ScanStore};
 use odocal_solver::{Calibration, Params, Predictor, SolveOptions, Verdict};
+use std::borrow::Cow;
 use std::time::Instant;
 
 /// Pairs matched with identity first guesses to bootstrap the odometry guesses of
-/// the others (only when there are at least twice as many pairs).
+/// the others when there are at least twice as many pairs (with fewer, all pairs are
+/// matched from identity first, and the failures again from odometry).
 pub const BOOTSTRAP_PAIRS: usize = 300;
 
 /// Fewest samples the pipeline hands to the solver.
@@ -43,17 +48,29 @@ pub struct Options {
     pub estimate_time_offset: Option<f64>,
     /// Parameters for the first guesses of scan matching (odometry prediction).
     pub initial_params: Option<Params>,
-    /// Without `initial_params`: match [`BOOTSTRAP_PAIRS`] evenly spread pairs with
-    /// identity guesses, solve roughly, and guess the other pairs by odometry with
-    /// that estimate (fewer ICP iterations and failures). Off: identity for all.
+    /// Without `initial_params`: match [`BOOTSTRAP_PAIRS`] evenly spread pairs (all
+    /// pairs of a shorter log) with identity guesses, solve roughly, and guess the
+    /// other pairs and the failed ones by odometry with that estimate (fewer ICP
+    /// iterations and failures). Off: identity for all.
     pub bootstrap_guesses: bool,
     /// Match again with first guesses predicted from the first estimate.
     pub second_pass: bool,
     /// Scan matcher settings.
     pub icp: IcpParams,
-    /// Return numbers even when some parameters are only weakly determined (by
-    /// default that is an error naming them).
+    /// Return numbers even when some parameters are only weakly determined or not
+    /// excited (by default that is an error naming them), at every solve: the
+    /// first, the second pass, and each solve of the clock-offset search.
     pub accept_weak: bool,
+}
+
+impl Options {
+    /// The solver's settings with [`Options::accept_weak`] passed on.
+    pub fn solve_options(&self) -> SolveOptions {
+        SolveOptions {
+            accept_weak: self.accept_weak || self.solve.accept_weak,
+            ..self.solve
+        }
+    }
 }
 
 impl Default for Options {
@@ -108,11 +125,16 @@ pub struct Synchronized {
     pub discarded: DiscardCounts,
     /// Clock offset used (s): laser clock minus encoder clock.
     pub time_offset: f64,
+    /// The scans were swept and the samples were matched after moving every ray to
+    /// the sensor frame at its scan's reference time (see [`crate::sweep`]).
+    pub sweep_compensated: bool,
 }
 
 /// The result of [`calibrate_log`].
 #[derive(Debug, Clone)]
 pub struct Outcome {
+    /// What the data-health stage found (and did), in the order found.
+    pub health: Vec<Finding>,
     /// Samples and discards.
     pub synced: Synchronized,
     /// The solver's output.
@@ -121,6 +143,8 @@ pub struct Outcome {
     pub offset: Option<OffsetEstimate>,
     /// Wall time per stage.
     pub timing: Timing,
+    /// The two halves of the samples calibrated separately and compared.
+    pub consistency: Consistency,
 }
 
 /// Ticks per revolution from the options or the log, checking the log has what
@@ -186,7 +210,15 @@ pub fn synchronize_and_match(
 ) -> Result<Synchronized, PipelineError> {
     let ticks = ticks_per_revolution(log, opts)?;
     let t_sync = Instant::now();
-    let scan_times: Vec<f64> = log.scans.scans.iter().map(|s| s.t).collect();
+    // Each scan stands for its reference time (the timestamp without a sweep).
+    let scan_times: Vec<f64> = (0..log.scans.len())
+        .map(|i| {
+            log.scans
+                .get(i)
+                .map_or(log.scans.scans[i].t, |s| reference_time(&s))
+        })
+        .collect();
+    let sweep = has_sweep(&log.scans);
     let stride = match opts.stride {
         Some(0) => {
             return Err(PipelineError::InvalidSetting(
@@ -223,11 +255,18 @@ pub fn synchronize_and_match(
     progress.start("matching", index_pairs.len());
     let mut matched: Vec<Option<Result<MatchStats, String>>> = vec![None; kept.len()];
     let mut guess_params = opts.initial_params;
-    if guess_params.is_none() && opts.bootstrap_guesses && kept.len() >= 2 * BOOTSTRAP_PAIRS {
-        // Match an evenly spread subset with identity guesses, solve roughly, and
-        // guess the rest by odometry with that estimate.
-        let every = kept.len() / BOOTSTRAP_PAIRS;
-        let subset: Vec<usize> = (0..kept.len()).step_by(every).collect();
+    let bootstrap = (opts.bootstrap_guesses || sweep) && kept.len() >= MIN_SAMPLES;
+    if guess_params.is_none() && bootstrap {
+        // Match a subset with identity guesses (an evenly spread one of long logs,
+        // every pair of short ones), solve roughly, and guess the rest — and the
+        // subset's failures — by odometry with that estimate (with a sweep:
+        // compensate with it too).
+        let every = (kept.len() / BOOTSTRAP_PAIRS).max(1);
+        let subset: Vec<usize> = if kept.len() >= 2 * BOOTSTRAP_PAIRS {
+            (0..kept.len()).step_by(every).collect()
+        } else {
+            (0..kept.len()).collect()
+        };
         let sub_pairs: Vec<(usize, usize)> = subset.iter().map(|&i| index_pairs[i]).collect();
         let identity = vec![Pose2::IDENTITY; subset.len()];
         let results = match_pairs(&log.scans, &sub_pairs, &identity, &opts.icp, || {
@@ -248,14 +287,36 @@ pub fn synchronize_and_match(
             .collect();
         let rough = SolveOptions {
             refine: false,
-            ..opts.solve
+            ..opts.solve_options()
         };
         guess_params = odocal_solver::calibrate(&samples, &rough)
             .ok()
             .map(|c| c.params)
             .filter(|p| p.r_l > 0.0 && p.r_r > 0.0 && p.b > 0.0);
         for (i, r) in subset.into_iter().zip(results) {
-            matched[i] = Some(r);
+            // A failure is matched again from the odometry guess when there is one.
+            if r.is_ok() || guess_params.is_none() {
+                matched[i] = Some(r);
+            }
+        }
+    }
+    // With a sweep and an estimate to compensate it with, every pair is matched on the
+    // compensated scans (the bootstrap's matches are replaced).
+    let mut scans = Cow::Borrowed(&log.scans);
+    let mut uncovered = vec![false; kept.len()];
+    if let (true, Some(p)) = (sweep, guess_params.as_ref()) {
+        let (store, covered) = compensated_pairs(
+            &log.scans,
+            &index_pairs,
+            &track,
+            &limits,
+            p,
+            opts.time_offset,
+        );
+        scans = Cow::Owned(store);
+        for (i, ok) in covered.into_iter().enumerate() {
+            uncovered[i] = !ok;
+            matched[i] = (!ok).then(|| Err("the encoders do not cover the sweep".into()));
         }
     }
     let rest: Vec<usize> = (0..kept.len()).filter(|&i| matched[i].is_none()).collect();
@@ -263,9 +324,10 @@ pub fn synchronize_and_match(
         rest.iter().map(|&i| (i, kept[i].1.clone())).collect();
     let guesses = first_guesses(&rest_motions, guess_params.as_ref(), opts.use_profile);
     let rest_pairs: Vec<(usize, usize)> = rest.iter().map(|&i| index_pairs[i]).collect();
-    let results = match_pairs(&log.scans, &rest_pairs, &guesses, &opts.icp, || {
+    let results = match_pairs(&scans, &rest_pairs, &guesses, &opts.icp, || {
         progress.advance()
     });
+    let sweep_compensated = matches!(scans, Cow::Owned(_));
     for (i, r) in rest.into_iter().zip(results) {
         matched[i] = Some(r);
     }
@@ -273,13 +335,14 @@ pub fn synchronize_and_match(
     timing.r#match += t_match.elapsed().as_secs_f64();
 
     let mut samples = Vec::with_capacity(kept.len());
-    for ((k, wheel), m) in kept.into_iter().zip(matched) {
+    for (((k, wheel), m), uncovered) in kept.into_iter().zip(matched).zip(uncovered) {
         match m.unwrap_or_else(|| Err("not matched".into())) {
             Ok(icp) => samples.push(PairSample {
                 pair: pairs[k],
                 wheel,
                 icp,
             }),
+            Err(_) if uncovered => discarded.add(DiscardReason::EncoderGap),
             Err(_) => discarded.add(DiscardReason::MatchFailed),
         }
     }
@@ -291,10 +354,13 @@ pub fn synchronize_and_match(
         samples,
         discarded,
         time_offset: opts.time_offset,
+        sweep_compensated,
     })
 }
 
-/// Matches the samples again with first guesses from `params`.
+/// Matches the samples again with first guesses from `params` — and, when the scans
+/// were swept, after compensating the sweep with `params` (samples whose sweeps the
+/// encoders do not cover are discarded as encoder gaps).
 fn second_pass(
     log: &Log,
     synced: &mut Synchronized,
@@ -314,16 +380,32 @@ fn second_pass(
         .iter()
         .map(|s| (s.pair.first, s.pair.second))
         .collect();
+    let (scans, covered) = if has_sweep(&log.scans) {
+        let track = EncoderTrack::new(&log.encoders, synced.ticks_per_revolution);
+        let (store, covered) = compensated_pairs(
+            &log.scans,
+            &index_pairs,
+            &track,
+            &synced.limits,
+            params,
+            synced.time_offset,
+        );
+        synced.sweep_compensated = true;
+        (Cow::<ScanStore>::Owned(store), covered)
+    } else {
+        (Cow::Borrowed(&log.scans), vec![true; index_pairs.len()])
+    };
     progress.start("matching (second pass)", index_pairs.len());
     let matched: Vec<Result<MatchStats, String>> =
-        match_pairs(&log.scans, &index_pairs, &guesses, &opts.icp, || {
+        match_pairs(&scans, &index_pairs, &guesses, &opts.icp, || {
             progress.advance()
         });
     progress.finish();
     let old = std::mem::take(&mut synced.samples);
-    for (s, m) in old.into_iter().zip(matched) {
+    for ((s, m), covered) in old.into_iter().zip(matched).zip(covered) {
         match m {
-            Ok(icp) => synced.samples.push(PairSample { icp, ..s }),
+            Ok(icp) if covered => synced.samples.push(PairSample { icp, ..s }),
+            Ok(_) => synced.discarded.add(DiscardReason::EncoderGap),
             Err(_) => synced.discarded.add(DiscardReason::MatchFailed),
         }
     }
@@ -357,7 +439,8 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         .iter()
         .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
         .collect();
-    let calibration = odocal_solver::calibrate(&samples, &opts.solve)?;
+    let solve_options = opts.solve_options();
+    let calibration = odocal_solver::calibrate(&samples, &solve_options)?;
     let poor: Vec<String> = calibration
         .observability
         .parameters
@@ -365,7 +448,7 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         .filter(|p| p.verdict != Verdict::WellDetermined)
         .map(|p| p.name.clone())
         .collect();
-    if !poor.is_empty() && !opts.accept_weak {
+    if !poor.is_empty() && !solve_options.accept_weak {
         return Err(PipelineError::NotDetermined {
             parameters: poor,
             sentence: calibration.observability.sentence.clone(),
@@ -376,26 +459,24 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
 
 /// Runs the pipeline on a log already in memory. Scan matching runs on rayon's
 /// current thread pool (wrap the call in `ThreadPool::install` to choose the count).
+///
+/// Order: the data-health stage (repairs, findings), synchronization and matching,
+/// the checks on the samples (clock offset, slip), the clock-offset estimate when
+/// asked, then the solve and its observability verdicts — so that the verdicts are
+/// those of the data at the estimated offset. A refusal names the data faults found.
 pub fn calibrate_log(
     log: &Log,
     opts: &Options,
     progress: &dyn Progress,
 ) -> Result<Outcome, PipelineError> {
     let mut timing = Timing::default();
-    let mut synced = synchronize_and_match(log, opts, progress, &mut timing)?;
-
-    let t_solve = Instant::now();
-    let mut calibration = solve(&synced, opts)?;
-    timing.solve += t_solve.elapsed().as_secs_f64();
-
-    if opts.second_pass {
-        let t = Instant::now();
-        second_pass(log, &mut synced, &calibration.params, opts, progress);
-        timing.r#match += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        calibration = solve(&synced, opts)?;
-        timing.solve += t.elapsed().as_secs_f64();
-    }
+    let (log, mut findings) = health::check_log(log, opts);
+    let log: &Log = &log;
+    let mut synced = synchronize_and_match(log, opts, progress, &mut timing)
+        .map_err(|e| PipelineError::with_faults(e, &findings))?;
+    findings.extend(health::clock_offset::quick_check(log, &synced, opts));
+    // A swept log is matched again after compensating with the refined estimate.
+    let sweep = has_sweep(&log.scans);
 
     let mut offset = None;
     if let Some(range) = opts.estimate_time_offset {
@@ -404,20 +485,108 @@ pub fn calibrate_log(
                 "the clock-offset search range must be positive, got {range} s"
             )));
         }
+        // Estimate first, on an estimate not yet judged: the verdicts come after.
         let t = Instant::now();
-        let est = estimate_time_offset(log, &synced, opts, opts.time_offset, range, &calibration)?;
+        let lenient = Options {
+            accept_weak: true,
+            ..opts.clone()
+        };
+        let base =
+            solve(&synced, &lenient).map_err(|e| PipelineError::with_faults(e, &findings))?;
+        timing.solve += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let start = opts.time_offset;
+        let est = estimate_time_offset(log, &synced, opts, start, range, &base)?;
+        findings.extend(edge_warning(log, &synced, start, range, est.offset));
         resynchronize(log, &mut synced, est.offset);
         timing.time_offset += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        calibration = solve(&synced, opts)?;
-        timing.solve += t.elapsed().as_secs_f64();
         offset = Some(est);
     }
+    // Slip is judged at the offset finally used.
+    findings.extend(health::slip::episodes(log, &synced));
+
+    let t_solve = Instant::now();
+    // With a sweep this estimate only compensates the sweep again (at the offset now
+    // used): the verdicts are those of the final solve.
+    let lenient = Options {
+        accept_weak: true,
+        ..opts.clone()
+    };
+    let first = if sweep { &lenient } else { opts };
+    let mut calibration =
+        solve(&synced, first).map_err(|e| PipelineError::with_faults(e, &findings))?;
+    timing.solve += t_solve.elapsed().as_secs_f64();
+
+    if opts.second_pass || sweep {
+        let t = Instant::now();
+        second_pass(log, &mut synced, &calibration.params, opts, progress);
+        timing.r#match += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        calibration = solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
+        timing.solve += t.elapsed().as_secs_f64();
+    }
+
+    let t = Instant::now();
+    let samples: Vec<_> = synced
+        .samples
+        .iter()
+        .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
+        .collect();
+    let consistency = check_halves(&samples, &opts.solve_options());
+    timing.solve += t.elapsed().as_secs_f64();
 
     Ok(Outcome {
+        health: findings,
         synced,
         calibration,
         offset,
         timing,
+        consistency,
+    })
+}
+
+/// A warning when the estimated offset lies at the edge of the search range: the true
+/// offset may lie beyond it.
+fn edge_warning(
+    log: &Log,
+    synced: &Synchronized,
+    start: f64,
+    range: f64,
+    estimate: f64,
+) -> Option<Finding> {
+    let step = range / ((range / crate::time_offset::GRID_STEP_S).round().max(5.0));
+    if (estimate - start).abs() < range - 1.5 * step {
+        return None;
+    }
+    let quick = health::clock_offset::quick_estimate(
+        log,
+        synced,
+        start,
+        health::clock_offset::QUICK_RANGE_S.max(2.0 * range),
+    );
+    let wider = match quick {
+        Some(q) if health::clock_offset::is_large(&q, start) => {
+            health::clock_offset::suggested_range(q.offset - start).max(2.0 * range)
+        }
+        _ => 2.0 * range,
+    };
+    let hint = match quick {
+        Some(q) => format!(
+            "; the quick check puts it near {:+.2} s (correlation {:.3})",
+            q.offset, q.correlation
+        ),
+        None => String::new(),
+    };
+    Some(Finding {
+        kind: FaultKind::ClockOffset,
+        severity: Severity::Warning,
+        count: 1,
+        first_line: None,
+        time: None,
+        message: format!(
+            "the estimated clock offset {estimate:+.3} s lies at the edge of the search range \
+             ({start:+.2} ± {range:.2} s): the true offset may lie beyond it{hint}; widen the \
+             search with `--time-offset-range {wider}`"
+        ),
     })
 }

@@ -3,8 +3,10 @@
 
 use crate::matching::MatchStats;
 use crate::sync::{ScanPair, WheelMotion};
-use odocal_log::TupleRecord;
+use odocal_log::{write_tuple, TupleRecord};
 use odocal_solver::{ProfileSegment, Sample};
+use std::io;
+use std::path::Path;
 
 /// One scan pair that survived synchronization and matching.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,6 +30,7 @@ impl PairSample {
             dphi_r: self.wheel.dphi_r,
             sm: self.icp.pose,
             sm_cov: use_icp_covariance.then_some(self.icp.covariance),
+            scan_times: Some([self.pair.t0, self.pair.t1]),
             profile: use_profile.then(|| {
                 self.wheel
                     .profile
@@ -85,6 +88,7 @@ pub fn wheel_only_sample(w: &WheelMotion) -> Sample {
         dphi_r: w.dphi_r,
         sm: odocal_geom::Pose2::IDENTITY,
         sm_cov: None,
+        scan_times: None,
         profile: Some(
             w.profile
                 .iter()
@@ -96,4 +100,14 @@ pub fn wheel_only_sample(w: &WheelMotion) -> Sample {
                 .collect(),
         ),
     }
+}
+
+/// Writes the samples as tuples, one JSON object per line.
+pub fn write_tuples(path: &Path, samples: &[PairSample]) -> io::Result<()> {
+    crate::atomic_file::write_atomically(path, |w| {
+        for s in samples {
+            write_tuple(&mut *w, &s.to_tuple())?;
+        }
+        Ok(())
+    })
 }

@@ -280,11 +280,13 @@ impl<'a> EncoderTrack<'a> {
             if rec.t - tp > limits.max_encoder_gap {
                 return Err(DiscardReason::EncoderGap);
             }
-            let (l, r) = (rec.left as f64, rec.right as f64);
+            // A record at the same instant as the last (colliding timestamps) adds
+            // its counts to the next piece, so that the pieces still sum up.
             if rec.t > tp {
+                let (l, r) = (rec.left as f64, rec.right as f64);
                 profile.push(self.piece(rec.t - tp, l - lp, r - rp));
+                (tp, lp, rp) = (rec.t, l, r);
             }
-            (tp, lp, rp) = (rec.t, l, r);
         }
         if t1 > tp {
             profile.push(self.piece(t1 - tp, l1 - lp, r1 - rp));

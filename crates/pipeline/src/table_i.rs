@@ -9,8 +9,8 @@
 //! The simulation itself is the caller's (this crate does not depend on the simulator).
 //!
 //! Two sources of rows:
-//! - a *table file* ([`read_table_file`]), e.g. `fixtures/table-i.json` for the ICRA 2008
-//!   Table I once it is transcribed;
+//! - a *table file* ([`read_table`]), e.g. `fixtures/table-i.json`: the ICRA 2008
+//!   Table I (19 rows, with its Table II of UMBmark trials);
 //! - the T-RO 2013 package's published results ([`read_tro_reference`]): for each
 //!   configuration `NAME` in [`TRO_CONFIGURATIONS`], `NAME_results.json` (the
 //!   parameters and their covariance) and `NAME.tuple` (whose count of tuples is the
@@ -19,7 +19,9 @@
 //! # Table file format
 //!
 //! JSON: an array of rows, or an object holding the array under `rows` (or
-//! `table_i`); other top-level fields (a citation, notes) are ignored. One row:
+//! `table_i`) and optionally `citation` (the full reference), `label` (a short name
+//! of the source, used in the rows' `source`) and `table_ii` (UMBmark trials, below);
+//! other top-level fields (notes) are ignored. One row:
 //!
 //! ```json
 //! { "name": "k07", "samples": 1500,
@@ -38,10 +40,21 @@
 //! (`docs/method.md`: the ICRA 2008 Table I has its `r_L` and `r_R` headings swapped
 //! relative to eq. (2), which [`j_consistency`] reveals). `sigma` (optional) holds the
 //! published standard deviations, same keys and units as `si`.
+//!
+//! `table_ii` is `{"note": "...", "rows": [...]}`, one row per UMBmark trial
+//! ([`UmbmarkTrial`]):
+//!
+//! ```json
+//! { "trial": "1", "b": 0.0897, "r_l": 0.021, "r_r": 0.021,
+//!   "E_b": 0.9968, "E_d": 0.9996, "E_max": 8.2,
+//!   "j11": 0.0105, "j12": 0.0105, "j21": -0.2341, "j22": 0.2340 }
+//! ```
+//!
+//! (made-up numbers; `E_b`, `E_d`, `E_max` and the J columns optional).
 
 use crate::error::PipelineError;
+use crate::estimate::Estimate;
 use crate::progress::NoProgress;
-use crate::report::{build_report, Report};
 use crate::run::{calibrate_log, Options};
 use odocal_geom::{wrap_angle, Pose2};
 use odocal_log::{read_carmen_from, read_tuples, ReadOptions};
@@ -72,10 +85,14 @@ pub fn workspace_table_path() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/table-i.json")
 }
 
-/// The reference data beside the workspace, `../shared/reference/` (never copied into
-/// the repository).
+/// The reference data: the directory named by the environment variable
+/// `ODOCAL_REFERENCE_DIR` when set (e.g. for a git worktree elsewhere), else
+/// `../shared/reference/` beside the workspace (never copied into the repository).
 pub fn workspace_reference_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference")
+    match std::env::var_os("ODOCAL_REFERENCE_DIR") {
+        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference"),
+    }
 }
 
 /// Why published rows could not be read.
@@ -218,6 +235,15 @@ struct FileRow {
     name: String,
     samples: u64,
     si: PrintedParams,
+    #[serde(flatten)]
+    j: FileJ,
+    #[serde(default)]
+    sigma: Option<PrintedParams>,
+}
+
+/// Printed J columns of a file row (any may be missing).
+#[derive(Deserialize, Default)]
+struct FileJ {
     #[serde(default, alias = "J11")]
     j11: Option<f64>,
     #[serde(default, alias = "J12")]
@@ -226,8 +252,46 @@ struct FileRow {
     j21: Option<f64>,
     #[serde(default, alias = "J22")]
     j22: Option<f64>,
+}
+
+impl FileJ {
+    /// The J columns, `None` when none is printed; an error when J21 or J22 is
+    /// missing but others are printed.
+    fn printed(&self) -> Result<Option<PrintedJ>, String> {
+        match (self.j21, self.j22) {
+            (Some(j21), Some(j22)) => Ok(Some(PrintedJ {
+                j11: self.j11,
+                j12: self.j12,
+                j21,
+                j22,
+            })),
+            (None, None) if self.j11.is_none() && self.j12.is_none() => Ok(None),
+            _ => Err("J columns need both j21 and j22".into()),
+        }
+    }
+}
+
+#[derive(Deserialize)]
+struct FileTrial {
+    trial: String,
+    b: f64,
+    r_l: f64,
+    r_r: f64,
+    #[serde(default, rename = "E_b")]
+    e_b: Option<f64>,
+    #[serde(default, rename = "E_d")]
+    e_d: Option<f64>,
+    #[serde(default, rename = "E_max")]
+    e_max: Option<f64>,
+    #[serde(flatten)]
+    j: FileJ,
+}
+
+#[derive(Deserialize)]
+struct FileTableII {
     #[serde(default)]
-    sigma: Option<PrintedParams>,
+    note: Option<String>,
+    rows: Vec<FileTrial>,
 }
 
 #[derive(Deserialize)]
@@ -237,59 +301,109 @@ enum TableFile {
     Keyed {
         #[serde(alias = "table_i")]
         rows: Vec<FileRow>,
+        #[serde(default)]
+        citation: Option<String>,
+        #[serde(default)]
+        label: Option<String>,
+        #[serde(default)]
+        table_ii: Option<FileTableII>,
     },
 }
 
-/// Reads a table file (format in the module documentation).
+/// One trial of a UMBmark calibration table (the ICRA 2008 Table II): the wheel
+/// distance and radii it gives. UMBmark corrects only the ratios b/r̄ and r_R/r_L;
+/// the mean radius stays at its nominal value.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct UmbmarkTrial {
+    /// Trial name (`nominal`, `1`, …).
+    pub trial: String,
+    /// Wheel distance (m).
+    pub b: f64,
+    /// Column "r_L" (m).
+    pub r_l: f64,
+    /// Column "r_R" (m).
+    pub r_r: f64,
+    /// Printed E_b = b / b_nominal, when printed.
+    pub e_b: Option<f64>,
+    /// Printed E_d (ratio of the wheel diameters), when printed.
+    pub e_d: Option<f64>,
+    /// Printed E_max (largest UMBmark return error), when printed.
+    pub e_max: Option<f64>,
+    /// The printed J columns, when printed.
+    pub j: Option<PrintedJ>,
+}
+
+/// A table file: its rows, UMBmark trials and citation.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PublishedTable {
+    /// The full reference, when the file gives one.
+    pub citation: Option<String>,
+    /// The published rows.
+    pub rows: Vec<PublishedRow>,
+    /// The note of the UMBmark table, when the file has one.
+    pub umbmark_note: Option<String>,
+    /// The UMBmark trials (empty when the file has none).
+    pub umbmark: Vec<UmbmarkTrial>,
+}
+
+/// Reads a table file's rows (format in the module documentation).
 pub fn read_table_file(path: &Path) -> Result<Vec<PublishedRow>, TableError> {
+    Ok(read_table(path)?.rows)
+}
+
+/// Reads a table file: rows, UMBmark trials, citation.
+pub fn read_table(path: &Path) -> Result<PublishedTable, TableError> {
     let text = std::fs::read_to_string(path).map_err(|source| TableError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    parse_table(&text, path)
+    parse_table_document(&text, path)
 }
 
-/// Parses the text of a table file; `path` names it in messages and in the rows'
-/// source.
+/// Parses the text of a table file's rows; `path` names it in messages and in the
+/// rows' source.
 pub fn parse_table(text: &str, path: &Path) -> Result<Vec<PublishedRow>, TableError> {
+    Ok(parse_table_document(text, path)?.rows)
+}
+
+/// Parses the text of a table file: rows, UMBmark trials, citation.
+pub fn parse_table_document(text: &str, path: &Path) -> Result<PublishedTable, TableError> {
     let err = |message: String| TableError::Format {
         path: path.to_path_buf(),
         message,
     };
-    let rows = match serde_json::from_str::<TableFile>(text) {
-        Ok(TableFile::Rows(r)) | Ok(TableFile::Keyed { rows: r }) => r,
+    let (rows, citation, label, table_ii) = match serde_json::from_str::<TableFile>(text) {
+        Ok(TableFile::Rows(r)) => (r, None, None, None),
+        Ok(TableFile::Keyed {
+            rows,
+            citation,
+            label,
+            table_ii,
+        }) => (rows, citation, label, table_ii),
         Err(e) => {
             return Err(err(format!(
                 "{e}; expected an array of rows (or {{\"rows\": [...]}}), each with name, \
                  samples, si {{r_l, r_r, b, l_x, l_y, l_theta}} and optionally j21, j22 \
-                 (j11, j12) and sigma"
+                 (j11, j12) and sigma; optionally table_ii {{\"rows\": [...]}} of UMBmark \
+                 trials, each with trial, b, r_l, r_r"
             )))
         }
     };
+    let source = label.unwrap_or_else(|| {
+        format!(
+            "table file `{}`",
+            path.file_name()
+                .unwrap_or(path.as_os_str())
+                .to_string_lossy()
+        )
+    });
     let mut out = Vec::with_capacity(rows.len());
     for r in rows {
-        let j = match (r.j21, r.j22) {
-            (Some(j21), Some(j22)) => Some(PrintedJ {
-                j11: r.j11,
-                j12: r.j12,
-                j21,
-                j22,
-            }),
-            (None, None) if r.j11.is_none() && r.j12.is_none() => None,
-            _ => {
-                return Err(err(format!(
-                    "row '{}': J columns need both j21 and j22",
-                    r.name
-                )))
-            }
-        };
+        let j =
+            r.j.printed()
+                .map_err(|m| err(format!("row '{}': {m}", r.name)))?;
         let row = PublishedRow {
-            source: format!(
-                "table file `{}`",
-                path.file_name()
-                    .unwrap_or(path.as_os_str())
-                    .to_string_lossy()
-            ),
+            source: source.clone(),
             samples: r.samples,
             printed: r.si,
             j,
@@ -305,7 +419,41 @@ pub fn parse_table(text: &str, path: &Path) -> Result<Vec<PublishedRow>, TableEr
         }
         out.push(row);
     }
-    Ok(out)
+    let (umbmark_note, trials) = match table_ii {
+        Some(t) => (t.note, t.rows),
+        None => (None, Vec::new()),
+    };
+    let mut umbmark = Vec::with_capacity(trials.len());
+    for t in trials {
+        let j =
+            t.j.printed()
+                .map_err(|m| err(format!("table_ii trial '{}': {m}", t.trial)))?;
+        if ![t.b, t.r_l, t.r_r]
+            .iter()
+            .all(|v| v.is_finite() && *v > 0.0 && *v < 10.0)
+        {
+            return Err(err(format!(
+                "table_ii trial '{}': b, r_l, r_r must be positive lengths in metres",
+                t.trial
+            )));
+        }
+        umbmark.push(UmbmarkTrial {
+            trial: t.trial,
+            b: t.b,
+            r_l: t.r_l,
+            r_r: t.r_r,
+            e_b: t.e_b,
+            e_d: t.e_d,
+            e_max: t.e_max,
+            j,
+        });
+    }
+    Ok(PublishedTable {
+        citation,
+        rows: out,
+        umbmark_note,
+        umbmark,
+    })
 }
 
 #[derive(Deserialize)]
@@ -407,7 +555,7 @@ pub struct Reproduction {
     /// The number of samples asked of the simulation.
     pub target_samples: usize,
     /// The pipeline's result on the simulated log.
-    pub report: Report,
+    pub estimate: Estimate,
 }
 
 /// One quantity of a [`Reproduction`], compared.
@@ -473,7 +621,7 @@ impl Reproduction {
     /// Compares every quantity of [`QUANTITY_NAMES`] with the row.
     pub fn checks(&self, tol: &Tolerances) -> Vec<QuantityCheck> {
         let truth = self.truth;
-        let rep = &self.report;
+        let rep = &self.estimate;
         let recovered = Params::from_vector(rep.values());
         let mut published: Vec<f64> = truth.to_vector().to_vec();
         let tj = truth.j();
@@ -560,6 +708,14 @@ impl Reproduction {
     }
 }
 
+/// The pipeline options of the reproduction: the defaults with the original
+/// package's T-RO trimming rule, as the published results were computed.
+pub fn reproduction_options() -> Options {
+    let mut opts = Options::default();
+    opts.solve.trim = odocal_solver::Trim::TRO;
+    opts
+}
+
 /// Runs the whole pipeline (read → synchronize → match → solve) on the text of a
 /// Carmen log simulated with `row`'s parameters ([`PublishedRow::truth`]) and
 /// returns the comparison material. `target_samples` is the number of samples the
@@ -576,12 +732,11 @@ pub fn reproduce_from_text(
     let parse = t_read.elapsed().as_secs_f64();
     let mut outcome = calibrate_log(&log, opts, &NoProgress)?;
     outcome.timing.parse = parse;
-    let report = build_report(Path::new(&name), &log, opts, &outcome);
     Ok(Reproduction {
         row: row.clone(),
         truth: row.truth(),
         target_samples,
-        report,
+        estimate: Estimate::of(&outcome),
     })
 }
 
@@ -615,6 +770,10 @@ pub struct JConsistency {
     pub deviation_as_printed: f64,
     /// Largest relative deviation of the printed J from `from_swapped`.
     pub deviation_swapped: f64,
+    /// Largest absolute deviation of the printed J from `from_headings`.
+    pub abs_deviation_as_printed: f64,
+    /// Largest absolute deviation of the printed J from `from_swapped`.
+    pub abs_deviation_swapped: f64,
     /// The verdict at the tolerance asked.
     pub reading: JReading,
 }
@@ -632,21 +791,53 @@ fn max_relative_deviation(printed: &[f64; 4], model: &[f64; 4]) -> f64 {
         .fold(0.0, f64::max)
 }
 
+fn max_absolute_deviation(printed: &[f64; 4], model: &[f64; 4]) -> f64 {
+    printed
+        .iter()
+        .zip(model)
+        .filter(|(p, _)| p.is_finite())
+        .map(|(p, m)| (p - m).abs())
+        .fold(0.0, f64::max)
+}
+
 /// Checks a row's printed J columns against eq. (2) under the printed and the
 /// swapped radius headings; `None` when the row has no J columns. `tolerance` is
 /// the relative deviation accepted as printing precision (e.g. `1e-3` for four
 /// significant digits).
 pub fn j_consistency(row: &PublishedRow, tolerance: f64) -> Option<JConsistency> {
-    let j = row.j.as_ref()?;
     let p = &row.printed;
+    Some(check_j(
+        &row.name,
+        p.r_l,
+        p.r_r,
+        p.b,
+        row.j.as_ref()?,
+        tolerance,
+    ))
+}
+
+/// [`j_consistency`] for a UMBmark trial; `None` when it has no J columns.
+pub fn umbmark_j_consistency(trial: &UmbmarkTrial, tolerance: f64) -> Option<JConsistency> {
+    let name = format!("UMBmark {}", trial.trial);
+    Some(check_j(
+        &name,
+        trial.r_l,
+        trial.r_r,
+        trial.b,
+        trial.j.as_ref()?,
+        tolerance,
+    ))
+}
+
+fn check_j(name: &str, r_l: f64, r_r: f64, b: f64, j: &PrintedJ, tolerance: f64) -> JConsistency {
     let printed = [
         j.j11.unwrap_or(f64::NAN),
         j.j12.unwrap_or(f64::NAN),
         j.j21,
         j.j22,
     ];
-    let from_headings = j_entries(p.r_l, p.r_r, p.b);
-    let from_swapped = j_entries(p.r_r, p.r_l, p.b);
+    let from_headings = j_entries(r_l, r_r, b);
+    let from_swapped = j_entries(r_r, r_l, b);
     let d1 = max_relative_deviation(&printed, &from_headings);
     let d2 = max_relative_deviation(&printed, &from_swapped);
     let reading = match (d1 <= tolerance, d2 <= tolerance) {
@@ -655,15 +846,17 @@ pub fn j_consistency(row: &PublishedRow, tolerance: f64) -> Option<JConsistency>
         (false, true) => JReading::HeadingsSwapped,
         (false, false) => JReading::Neither,
     };
-    Some(JConsistency {
-        name: row.name.clone(),
+    JConsistency {
+        name: name.to_string(),
         printed,
         from_headings,
         from_swapped,
         deviation_as_printed: d1,
         deviation_swapped: d2,
+        abs_deviation_as_printed: max_absolute_deviation(&printed, &from_headings),
+        abs_deviation_swapped: max_absolute_deviation(&printed, &from_swapped),
         reading,
-    })
+    }
 }
 
 /// Value, σ and error of a quantity in display units: (scale, unit, decimals).
@@ -692,7 +885,7 @@ fn quantity_label(name: &str) -> &'static str {
 /// published σ), the recovered value ± reported σ, the error (also relative for
 /// lengths of the odometry and J), the error in σ, the bound and the verdict.
 pub fn format_reproduction(rep: &Reproduction, tol: &Tolerances) -> String {
-    let r = &rep.report;
+    let r = &rep.estimate;
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -759,7 +952,7 @@ pub fn format_summary(reps: &[Reproduction], tol: &Tolerances) -> String {
             rep.row.name,
             rep.row.samples,
             rep.target_samples,
-            rep.report.samples_used,
+            rep.estimate.samples_used,
             rep.worst_error_in_sigma(tol),
             if rep.bounds_apply(tol) {
                 "checked"
@@ -769,7 +962,7 @@ pub fn format_summary(reps: &[Reproduction], tol: &Tolerances) -> String {
             if failures.is_empty() {
                 "pass".to_string()
             } else {
-                format!("FAIL ({})", failures.len())
+                format!("fail ({} check(s))", failures.len())
             }
         );
     }
@@ -781,7 +974,7 @@ pub fn format_j_consistency(checks: &[JConsistency], tolerance: f64) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| row | printed J11, J12, J21, J22 | eq. (2), headings as printed | eq. (2), r_L ↔ r_R | deviation as printed | deviation swapped | reading (tolerance {:.1e}) |",
+        "| row | printed J11, J12, J21, J22 | eq. (2), headings as printed | eq. (2), r_L ↔ r_R | largest \\|Δ\\| as printed (relative) | largest \\|Δ\\| swapped (relative) | reading (relative tolerance {:.1e}) |",
         tolerance
     );
     let _ = writeln!(s, "|---|---|---|---|---:|---:|---|");
@@ -800,15 +993,118 @@ pub fn format_j_consistency(checks: &[JConsistency], tolerance: f64) -> String {
     for c in checks {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.2e} | {:.2e} | {:?} |",
+            "| {} | {} | {} | {} | {:.1e} ({:.1e}) | {:.1e} ({:.1e}) | {:?} |",
             c.name,
             fmt(&c.printed),
             fmt(&c.from_headings),
             fmt(&c.from_swapped),
+            c.abs_deviation_as_printed,
             c.deviation_as_printed,
+            c.abs_deviation_swapped,
             c.deviation_swapped,
             c.reading
         );
+    }
+    s
+}
+
+/// The simulation seed of a row: `seed` mixed with a hash (FNV-1a) of the row's
+/// name, so a row gets the same log whichever other rows run.
+pub fn row_seed(seed: u64, name: &str) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in name.bytes() {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h ^ seed
+}
+
+/// One line of the UMBmark comparison: a name and (b, r_L, r_R) in metres.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OdometryLine {
+    /// What the numbers are (e.g. "UMBmark trial 1", "odocal on the k22-k29 preset").
+    pub name: String,
+    /// Wheel distance (m).
+    pub b: f64,
+    /// Left wheel radius (m).
+    pub r_l: f64,
+    /// Right wheel radius (m).
+    pub r_r: f64,
+}
+
+/// A Markdown table of UMBmark trials beside other odometry calibrations: b, radii,
+/// mean radius r̄, and the ratios UMBmark can observe (b/r̄, r_R/r_L) of every trial,
+/// every line of `shown` and every line of `calibrations`; then each trial's
+/// differences from every line of `calibrations`.
+pub fn format_umbmark(
+    trials: &[UmbmarkTrial],
+    shown: &[OdometryLine],
+    calibrations: &[OdometryLine],
+) -> String {
+    let mut s = String::new();
+    let lines: Vec<OdometryLine> = trials
+        .iter()
+        .map(|t| OdometryLine {
+            name: format!("UMBmark trial {}", t.trial),
+            b: t.b,
+            r_l: t.r_l,
+            r_r: t.r_r,
+        })
+        .chain(shown.iter().cloned())
+        .chain(calibrations.iter().cloned())
+        .collect();
+    let _ = writeln!(
+        s,
+        "| calibration | b (mm) | r_L (mm) | r_R (mm) | r̄ (mm) | b/r̄ | r_R/r_L | J21 | J22 |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for l in &lines {
+        let mean = 0.5 * (l.r_l + l.r_r);
+        let _ = writeln!(
+            s,
+            "| {} | {:.2} | {:.3} | {:.3} | {:.3} | {:.4} | {:.5} | {:.5} | {:.5} |",
+            l.name,
+            l.b * 1e3,
+            l.r_l * 1e3,
+            l.r_r * 1e3,
+            mean * 1e3,
+            l.b / mean,
+            l.r_r / l.r_l,
+            -l.r_l / l.b,
+            l.r_r / l.b
+        );
+    }
+    if calibrations.is_empty() || trials.is_empty() {
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "\nDifferences, UMBmark trial minus calibration: b and r̄ in mm and in %, and the \
+         ratios in %.\n"
+    );
+    let _ = writeln!(
+        s,
+        "| trial | against | Δb (mm) | Δb (%) | Δr̄ (mm) | Δr̄ (%) | Δ(b/r̄) (%) | Δ(r_R/r_L) (%) |"
+    );
+    let _ = writeln!(s, "|---|---|---:|---:|---:|---:|---:|---:|");
+    for t in trials {
+        let tm = 0.5 * (t.r_l + t.r_r);
+        for c in calibrations {
+            let cm = 0.5 * (c.r_l + c.r_r);
+            let pct = |a: f64, b: f64| 100.0 * (a - b) / b;
+            let _ = writeln!(
+                s,
+                "| {} | {} | {:+.2} | {:+.2} | {:+.3} | {:+.2} | {:+.2} | {:+.3} |",
+                t.trial,
+                c.name,
+                (t.b - c.b) * 1e3,
+                pct(t.b, c.b),
+                (tm - cm) * 1e3,
+                pct(tm, cm),
+                pct(t.b / tm, c.b / cm),
+                pct(t.r_r / t.r_l, c.r_r / c.r_l)
+            );
+        }
     }
     s
 }
@@ -828,7 +1124,12 @@ mod tests {
          "j21": -0.2311111, "j22": 0.2355556},
         {"name": "no-j", "samples": 10,
          "si": {"r_l": 0.0208, "r_r": 0.0212, "b": 0.09, "l_x": 0.0, "l_y": 0.0, "l_theta": 0.0}}
-    ]}"#;
+    ], "label": "Made-up table",
+    "table_ii": {"note": "made up", "rows": [
+        {"trial": "1", "b": 0.09, "r_l": 0.0212, "r_r": 0.0208, "E_b": 1.0,
+         "j11": 0.0106, "j12": 0.0104, "j21": -0.2355556, "j22": 0.2311111},
+        {"trial": "2", "b": 0.08, "r_l": 0.02, "r_r": 0.02}
+    ]}}"#;
 
     fn table() -> Vec<PublishedRow> {
         parse_table(TABLE, Path::new("made-up.json")).unwrap()
@@ -847,6 +1148,46 @@ mod tests {
         assert_eq!(rows[0].sigma.unwrap()[2], 2e-4);
         assert_eq!(rows[2].truth().r_l, 0.0208);
         assert_eq!(rows[1].scaled_samples(0.5), 450);
+    }
+
+    #[test]
+    fn umbmark_trials_parse_and_compare() {
+        let t = parse_table_document(TABLE, Path::new("made-up.json")).unwrap();
+        assert_eq!(t.rows[0].source, "Made-up table");
+        assert_eq!(t.umbmark_note.as_deref(), Some("made up"));
+        assert_eq!(t.umbmark.len(), 2);
+        assert_eq!(t.umbmark[0].e_b, Some(1.0));
+        assert_eq!(t.umbmark[1].e_d, None);
+        let c = umbmark_j_consistency(&t.umbmark[0], 1e-3).unwrap();
+        assert_eq!(c.reading, JReading::AsPrinted);
+        assert!(c.abs_deviation_as_printed < 1e-6, "{c:?}");
+        assert!(umbmark_j_consistency(&t.umbmark[1], 1e-3).is_none());
+        let cal = OdometryLine {
+            name: "cal".into(),
+            b: 0.08,
+            r_l: 0.019,
+            r_r: 0.021,
+        };
+        let md = format_umbmark(&t.umbmark, &[], &[cal]);
+        // Trial 2 against the calibration: same b and mean radius, r_R/r_L 1 vs 21/19.
+        assert!(
+            md.contains("| 2 | cal | +0.00 | +0.00 | +0.000 | +0.00 | +0.00 | -9.524 |"),
+            "{md}"
+        );
+        let e = parse_table_document(
+            r#"{"rows": [], "table_ii": {"rows": [{"trial": "x", "b": -1, "r_l": 0.02, "r_r": 0.02}]}}"#,
+            Path::new("t.json"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("trial 'x'") && e.contains("positive"), "{e}");
+    }
+
+    #[test]
+    fn row_seeds_depend_on_the_name_only() {
+        assert_eq!(row_seed(1, "k07"), row_seed(1, "k07"));
+        assert_ne!(row_seed(1, "k07"), row_seed(1, "k08"));
+        assert_ne!(row_seed(1, "k07"), row_seed(2, "k07"));
     }
 
     #[test]

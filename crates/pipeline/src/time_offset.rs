@@ -94,7 +94,7 @@ impl Problem<'_> {
 
     fn cost(&self, offset: f64, every: usize) -> f64 {
         let samples = self.samples_at(offset, every);
-        let mut solve = self.opts.solve;
+        let mut solve = self.opts.solve_options();
         solve.refine = false;
         match odocal_solver::calibrate(&samples, &solve) {
             Ok(c) => self.cost_with(&c.params, &samples),

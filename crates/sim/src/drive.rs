@@ -144,6 +144,14 @@ impl Drive {
         self.state_after(dt, t_us as f64 * 1e-6)
     }
 
+    /// The exact state at `t_us` (µs since the start, fractional), which must lie
+    /// within the current sub-step (its end included): the time of one ray of a sweep.
+    pub fn state_at_fractional_us(&self, t_us: f64) -> DriveState {
+        let t0 = self.step_start_us() as f64;
+        debug_assert!(t_us >= t0 && t_us <= t0 + self.motors.substep_us as f64);
+        self.state_after((t_us - t0) * 1e-6, t_us * 1e-6)
+    }
+
     fn state_after(&self, dt: f64, t: f64) -> DriveState {
         let (v, omega) = self.body;
         DriveState {

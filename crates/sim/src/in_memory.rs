@@ -21,6 +21,9 @@ impl SimRun {
             "robot_wheel_ticks_per_revolution".into(),
             c.encoder.ticks_per_revolution.to_string(),
         );
+        if c.laser.time_increment != 0.0 {
+            params.laser_time_increment = Some(c.laser.time_increment);
+        }
         let mut log = Log {
             params,
             ..Log::default()

@@ -1,6 +1,7 @@
 //! The range finder: a Hokuyo URG-04LX by default (681 rays, 2π/1024 rad apart,
 //! ±120°, 4 m), with correlated Gaussian range noise, quantization and failures
-//! reported as 0.
+//! reported as 0. The rays are fired one after another when
+//! [`LaserConfig::time_increment`] is set (the sweep; see [`crate::laser_models`]).
 
 use crate::error::SimError;
 use crate::world::World;
@@ -17,7 +18,7 @@ pub struct LaserConfig {
     pub num_rays: usize,
     /// Angle of ray 0 in the sensor frame (rad).
     pub start_angle: f64,
-    /// Angle between consecutive rays (rad).
+    /// Angle between consecutive rays (rad); negative for a clockwise scanner.
     pub resolution: f64,
     /// Maximum range (m): farther walls, and readings at or above it, give 0.
     pub max_range: f64,
@@ -37,6 +38,30 @@ pub struct LaserConfig {
     pub quantization: f64,
     /// Probability that a reading fails at random (reported as 0).
     pub dropout_probability: f64,
+    /// Seconds between two consecutive rays (the sweep): ray `i` is taken at the scan's
+    /// timestamp plus `i · time_increment`, from the pose the sensor has then. 0 = every
+    /// ray at the timestamp (the instantaneous scans of the Khepera presets).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub time_increment: f64,
+    /// Carmen laser type written in RAWLASER1 lines (0 SICK LMS, 2 Hokuyo URG, 99
+    /// other).
+    #[serde(default = "hokuyo_urg_type", skip_serializing_if = "is_hokuyo_urg")]
+    pub laser_type: i32,
+}
+
+// The two settings are left out of the configuration JSON at their defaults, so that
+// the truth files of instantaneous URG-04LX runs stay as they were.
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+fn is_hokuyo_urg(t: &i32) -> bool {
+    *t == hokuyo_urg_type()
+}
+
+/// The Carmen laser type of a Hokuyo URG.
+fn hokuyo_urg_type() -> i32 {
+    2
 }
 
 impl Default for LaserConfig {
@@ -56,6 +81,8 @@ impl Default for LaserConfig {
             correlation_rays: 4,
             quantization: 0.001,
             dropout_probability: 0.001,
+            time_increment: 0.0,
+            laser_type: hokuyo_urg_type(),
         }
     }
 }
@@ -72,10 +99,11 @@ impl LaserConfig {
         }
     }
 
-    /// The scan geometry as written to the log (laser type 2 = Hokuyo URG).
+    /// The scan geometry as written to the log, with its `time_increment` (and an
+    /// unknown `scan_time`, as a Carmen reader sees it).
     pub fn geometry(&self) -> ScanGeometry {
         let fields = LaserFields {
-            laser_type: 2,
+            laser_type: self.laser_type,
             start_angle: self.start_angle,
             fov: (self.num_rays.saturating_sub(1)) as f64 * self.resolution,
             resolution: self.resolution,
@@ -84,7 +112,12 @@ impl LaserConfig {
             accuracy: self.range_sigma,
             remission_mode: 0,
         };
-        ScanGeometry::new(fields, self.num_rays)
+        ScanGeometry::new(fields, self.num_rays).with_timing(self.time_increment, 0.0)
+    }
+
+    /// Duration (s) of one sweep, first ray to last.
+    pub fn sweep_duration(&self) -> f64 {
+        self.num_rays.saturating_sub(1) as f64 * self.time_increment
     }
 
     /// Ray angles in the sensor frame (rad).
@@ -106,11 +139,11 @@ impl LaserConfig {
         if self.num_rays == 0 {
             return bad("laser.num_rays", 0.0, "at least one ray");
         }
-        if !(self.resolution.is_finite() && self.resolution > 0.0) {
+        if !(self.resolution.is_finite() && self.resolution != 0.0) {
             return bad(
                 "laser.resolution",
                 self.resolution,
-                "a positive angle (rad)",
+                "a non-zero angle (rad; negative for a clockwise scanner)",
             );
         }
         if !self.start_angle.is_finite() {
@@ -154,6 +187,16 @@ impl LaserConfig {
         if !(self.quantization.is_finite() && self.quantization >= 0.0) {
             return bad("laser.quantization", self.quantization, "a step ≥ 0 (m)");
         }
+        if !(self.time_increment.is_finite()
+            && self.time_increment >= 0.0
+            && self.sweep_duration() < 1.0 / self.rate_hz)
+        {
+            return bad(
+                "laser.time_increment",
+                self.time_increment,
+                "≥ 0 s, the sweep shorter than the scan period",
+            );
+        }
         if !(0.0..=1.0).contains(&self.dropout_probability) {
             return bad(
                 "laser.dropout_probability",
@@ -187,6 +230,33 @@ impl LaserConfig {
         rng: &mut R,
     ) -> Vec<f32> {
         let truth = self.true_ranges(world, sensor_pose);
+        self.measure(&truth, rng)
+    }
+
+    /// One swept scan: ray `i` cast from `sensor_poses[i]` (the sensor's pose when it
+    /// fired that ray), with the error model of [`LaserConfig::scan`].
+    pub fn swept_scan<R: Rng + ?Sized>(
+        &self,
+        world: &World,
+        sensor_poses: &[Pose2],
+        rng: &mut R,
+    ) -> Vec<f32> {
+        debug_assert_eq!(sensor_poses.len(), self.num_rays);
+        let truth: Vec<f64> = self
+            .angles()
+            .iter()
+            .zip(sensor_poses)
+            .map(|(&a, p)| {
+                world
+                    .cast_ray([p.x, p.y], p.theta + a, self.max_range)
+                    .unwrap_or(f64::INFINITY)
+            })
+            .collect();
+        self.measure(&truth, rng)
+    }
+
+    /// The readings reported for the exact ranges `truth` (see [`LaserConfig::scan`]).
+    fn measure<R: Rng + ?Sized>(&self, truth: &[f64], rng: &mut R) -> Vec<f32> {
         let noise = self.correlated_noise(rng);
         truth
             .iter()

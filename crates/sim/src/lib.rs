@@ -1,10 +1,11 @@
-//! Simulator of a differential-drive robot with wheel encoders and a Hokuyo URG-04LX
-//! laser range finder, producing Carmen-style logs with exact ground truth.
+//! Simulator of a differential-drive robot with wheel encoders and a laser range finder
+//! (sweeping its rays or not), producing Carmen-style logs with exact ground truth.
 //!
 //! The pieces, each usable on its own:
 //! - [`World`]: line-segment worlds (presets [`World::khepera_arena`],
-//!   [`World::office`], [`World::corridor`]) with ray casting and clearance queries.
-//! - [`LaserConfig`]: the range finder's geometry and error model;
+//!   [`World::office`], [`World::corridor`], [`World::hall`]) with ray casting and clearance queries.
+//! - [`LaserConfig`]: the range finder's geometry, error model and sweep (named
+//!   models: [`LaserConfig::model`], [`LASER_MODELS`]);
 //!   [`LaserConfig::scan`] simulates one scan from a sensor pose (noise-free with
 //!   [`LaserConfig::noise_free`]), [`LaserConfig::true_ranges`] gives exact ranges.
 //! - [`RobotParams`], [`arc_motion`], [`Drive`]: kinematics and the motor model,
@@ -39,9 +40,11 @@ mod faults;
 mod in_memory;
 mod kinematics;
 mod laser;
+mod laser_models;
 mod output;
 mod planner;
 mod presets;
+mod robot_classes;
 mod simulation;
 mod truth;
 mod world;
@@ -54,9 +57,13 @@ pub use error::SimError;
 pub use faults::{FaultConfig, SlipEpisode};
 pub use kinematics::{arc_motion, RobotParams};
 pub use laser::LaserConfig;
+pub use laser_models::LASER_MODELS;
 pub use output::LogSummary;
 pub use planner::{MotionLimits, Planner, TrajectoryKind, TRAJECTORY_NAMES};
-pub use presets::{PresetRegistry, TableRow, BUILTIN_PRESETS};
+pub use presets::{
+    simulate_table_row, table_row_config, PresetRegistry, TableRow, BUILTIN_PRESETS,
+    SECONDS_PER_SAMPLE,
+};
 pub use simulation::{simulate, simulate_in, SimEncoderRecord, SimRun, SimScan};
 pub use truth::{GroundTruth, TruthFaults, TruthParams, TruthScan, TruthSlip, TRUTH_FORMAT};
 pub use world::{Segment, World};

@@ -33,7 +33,8 @@ enum Message {
 impl SimRun {
     /// Writes the log: `header` lines as comments, the PARAMs
     /// (`robot_wheel_ticks_per_revolution`, `robot_encoder_modulus` when counters wrap,
-    /// `laser_front_laser_min_range`), then ENCODER (each followed by its ODOM when
+    /// `laser_front_laser_min_range`, `laser_front_laser_time_increment` for a swept
+    /// laser), then ENCODER (each followed by its ODOM when
     /// enabled) and RAWLASER1 messages merged by logged timestamp, encoder first on
     /// ties. Dropped messages are left out; garbage lines are inserted after messages
     /// at the configured rate.
@@ -60,6 +61,10 @@ impl SimRun {
         }
         out.param("laser_front_laser_min_range", c.laser.min_range)?;
         sum.lines += 1;
+        if c.laser.time_increment != 0.0 {
+            out.param("laser_front_laser_time_increment", c.laser.time_increment)?;
+            sum.lines += 1;
+        }
 
         let mut order: Vec<(f64, u8, Message)> =
             Vec::with_capacity(self.encoders.len() + self.scans.len());

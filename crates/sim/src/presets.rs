@@ -3,23 +3,30 @@
 //!
 //! A Table I file is JSON: either an array of rows, or an object holding the array
 //! under `rows` or `table_i`. Each row has `name` (string), `samples` (number of
-//! samples, i.e. scan intervals) and `si` = `{r_l, r_r, b, l_x, l_y, l_theta}` in
-//! metres and radians. Other fields are ignored. A row becomes a preset named after
-//! the row: the `khepera` preset with the row's parameters as the true ones, and a
-//! duration of `samples` scan periods.
+//! calibration samples) and `si` = `{r_l, r_r, b, l_x, l_y, l_theta}` in metres and
+//! radians, and optionally the printed J columns `j21`, `j22` (also `J21`, `J22`).
+//! Other fields are ignored. A row becomes a preset named after the row
+//! ([`table_row_config`]): the `khepera` preset with the row's parameters as the true
+//! ones — the radii from `r_L = −b·J21`, `r_R = b·J22` when the row prints J (the
+//! ICRA 2008 Table I prints its `r_L`, `r_R` headings swapped; J is authoritative) —
+//! driven for `samples` × [`SECONDS_PER_SAMPLE`].
 
 use crate::config::SimConfig;
 use crate::error::SimError;
+use crate::kinematics::RobotParams;
 use crate::laser::LaserConfig;
 use crate::planner::TrajectoryKind;
+use crate::robot_classes;
 use crate::truth::TruthParams;
 use odocal_geom::Pose2;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 /// The built-in preset names.
-pub const BUILTIN_PRESETS: [&str; 7] = [
+pub const BUILTIN_PRESETS: [&str; 9] = [
     "khepera",
+    "turtlebot",
+    "pioneer",
     "khepera-displaced",
     "office",
     "corridor",
@@ -28,6 +35,11 @@ pub const BUILTIN_PRESETS: [&str; 7] = [
     "identical-turns",
 ];
 
+/// Seconds of driving per calibration sample: the calibration pipeline's default
+/// interval between the two scans of a sample (`odocal_pipeline::sync::TARGET_INTERVAL_S`,
+/// 4 scan periods at 10 Hz).
+pub const SECONDS_PER_SAMPLE: f64 = 0.4;
+
 /// One row of a Table I file (see the module documentation).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 pub struct TableRow {
@@ -35,8 +47,57 @@ pub struct TableRow {
     pub name: String,
     /// Number of samples of the experiment.
     pub samples: u64,
-    /// The calibrated parameters in SI units.
+    /// The calibrated parameters in SI units, under the headings as printed.
     pub si: TruthParams,
+    /// The printed J21 (`−r_L/b`), when the table has it.
+    #[serde(default, alias = "J21")]
+    pub j21: Option<f64>,
+    /// The printed J22 (`r_R/b`), when the table has it.
+    #[serde(default, alias = "J22")]
+    pub j22: Option<f64>,
+}
+
+impl TableRow {
+    /// The row's true parameters: `si`, except that with J columns the radii are
+    /// `r_L = −b·J21`, `r_R = b·J22`.
+    pub fn truth(&self) -> TruthParams {
+        let mut p = self.si;
+        if let (Some(j21), Some(j22)) = (self.j21, self.j22) {
+            p.r_l = -p.b * j21;
+            p.r_r = p.b * j22;
+        }
+        p
+    }
+}
+
+/// The `khepera` preset named `name` with `truth` as the true parameters, driven
+/// long enough for about `samples` calibration samples at [`SECONDS_PER_SAMPLE`]
+/// (the configuration of a Table I row).
+pub fn table_row_config(name: &str, truth: &RobotParams, samples: u64) -> SimConfig {
+    let mut c = builtin("khepera").unwrap_or_default();
+    c.preset = name.to_string();
+    c.robot = *truth;
+    if samples > 0 {
+        // Half a sample more, so that the last interval is complete.
+        c.duration = (samples as f64 + 0.5) * SECONDS_PER_SAMPLE;
+    }
+    c
+}
+
+/// The Carmen log text of a Table I row's simulation ([`table_row_config`] with
+/// `seed`), as `odocal table-i` and its tests calibrate it.
+pub fn simulate_table_row(
+    name: &str,
+    truth: &RobotParams,
+    samples: u64,
+    seed: u64,
+) -> Result<Vec<u8>, SimError> {
+    let mut config = table_row_config(name, truth, samples);
+    config.seed = seed;
+    let run = crate::simulation::simulate(&config)?;
+    let mut text = Vec::new();
+    run.write_log(&mut text, &[])?;
+    Ok(text)
 }
 
 /// The presets available to [`SimConfig::preset`] and the command line.
@@ -104,13 +165,20 @@ impl PresetRegistry {
             }
         };
         for row in &rows {
-            let p = row.si;
+            if row.j21.is_some() != row.j22.is_some() {
+                return Err(err(format!(
+                    "row '{}': J columns need both j21 and j22",
+                    row.name
+                )));
+            }
+            let p = row.truth();
             let lengths_ok = [p.r_l, p.r_r, p.b]
                 .iter()
                 .all(|v| v.is_finite() && *v > 0.0 && *v < 10.0);
             if !lengths_ok || ![p.l_x, p.l_y, p.l_theta].iter().all(|v| v.is_finite()) {
                 return Err(err(format!(
-                    "row '{}': si must hold positive radii and wheel distance (m) and a finite laser pose",
+                    "row '{}': si must hold positive radii (also −b·J21 and b·J22) and wheel \
+                     distance (m) and a finite laser pose",
                     row.name
                 )));
             }
@@ -146,17 +214,14 @@ impl PresetRegistry {
             return Ok(c);
         }
         if let Some(row) = self.rows.iter().find(|r| r.name == name) {
-            let mut c = builtin("khepera").unwrap_or_default();
-            c.preset = row.name.clone();
-            let p = row.si;
-            c.robot.r_l = p.r_l;
-            c.robot.r_r = p.r_r;
-            c.robot.b = p.b;
-            c.robot.laser = Pose2::new(p.l_x, p.l_y, p.l_theta);
-            if row.samples > 0 {
-                c.duration = row.samples as f64 / c.laser.rate_hz;
-            }
-            return Ok(c);
+            let t = row.truth();
+            let truth = RobotParams {
+                r_l: t.r_l,
+                r_r: t.r_r,
+                b: t.b,
+                laser: Pose2::new(t.l_x, t.l_y, t.l_theta),
+            };
+            return Ok(table_row_config(&row.name, &truth, row.samples));
         }
         let mut known = self.names().join(", ");
         if let Some(e) = &self.table_error {
@@ -207,8 +272,11 @@ fn builtin(name: &str) -> Option<SimConfig> {
         "straight-only" => c.trajectory = TrajectoryKind::StraightOnly,
         "spin-only" => c.trajectory = TrajectoryKind::SpinOnly,
         "identical-turns" => c.trajectory = TrajectoryKind::IdenticalTurns,
+        "turtlebot" => return Some(robot_classes::turtlebot(c)),
+        "pioneer" => return Some(robot_classes::pioneer(c)),
         _ => return None,
     }
+    // The Khepera presets keep the instantaneous URG-04LX of the logs they reproduce.
     debug_assert_eq!(c.laser, LaserConfig::default());
     Some(c)
 }
@@ -238,7 +306,10 @@ mod tests {
             &path,
             r#"{"citation": "test", "rows": [
                 {"name": "row-a", "samples": 1200, "extra": 1,
-                 "si": {"r_l": 0.021, "r_r": 0.022, "b": 0.09, "l_x": 0.01, "l_y": -0.02, "l_theta": 0.3}}
+                 "si": {"r_l": 0.021, "r_r": 0.022, "b": 0.09, "l_x": 0.01, "l_y": -0.02, "l_theta": 0.3}},
+                {"name": "row-j", "samples": 10,
+                 "si": {"r_l": 0.022, "r_r": 0.021, "b": 0.09, "l_x": 0, "l_y": 0, "l_theta": 0},
+                 "J21": -0.23, "J22": 0.24}
             ]}"#,
         )
         .unwrap();
@@ -247,7 +318,12 @@ mod tests {
         let c = reg.get("row-a").unwrap();
         assert_eq!(c.robot.r_r, 0.022);
         assert_eq!(c.robot.laser, Pose2::new(0.01, -0.02, 0.3));
-        assert_eq!(c.duration, 120.0);
+        assert_eq!(c.duration, 1200.5 * SECONDS_PER_SAMPLE);
+        // Printed J columns are authoritative for the radii.
+        let c = reg.get("row-j").unwrap();
+        assert!((c.robot.r_l - 0.09 * 0.23).abs() < 1e-15, "{}", c.robot.r_l);
+        assert!((c.robot.r_r - 0.09 * 0.24).abs() < 1e-15, "{}", c.robot.r_r);
+        c.validate().unwrap();
 
         std::fs::write(
             &path,
@@ -258,6 +334,38 @@ mod tests {
             .with_table_file(&path)
             .unwrap_err();
         assert!(e.to_string().contains("table.json"), "{e}");
+        std::fs::write(
+            &path,
+            r#"[{"name": "half-j", "samples": 1, "j21": -0.2,
+                 "si": {"r_l": 0.02, "r_r": 0.02, "b": 0.09, "l_x": 0, "l_y": 0, "l_theta": 0}}]"#,
+        )
+        .unwrap();
+        let e = PresetRegistry::builtin()
+            .with_table_file(&path)
+            .unwrap_err();
+        assert!(e.to_string().contains("both j21 and j22"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn every_row_of_the_project_table_is_a_valid_preset() {
+        let path = PresetRegistry::default_table_path();
+        if !path.exists() {
+            println!("skipped: no {}", path.display());
+            return;
+        }
+        let reg = PresetRegistry::builtin().with_table_file(&path).unwrap();
+        assert_eq!(reg.table_rows().len(), 19);
+        for row in reg.table_rows() {
+            let c = reg.get(&row.name).unwrap();
+            c.validate().unwrap();
+            assert!(row.j21.is_some() && row.j22.is_some(), "{}", row.name);
+        }
+        // ICRA 2008 Table I, k22-k29: b = 0.08682, J21 = −0.23012, J22 = 0.23029.
+        let c = reg.get("k22-k29").unwrap();
+        assert!((c.robot.r_l - 0.08682 * 0.23012).abs() < 1e-15);
+        assert!((c.robot.r_r - 0.08682 * 0.23029).abs() < 1e-15);
+        assert_eq!(c.robot.laser, Pose2::new(-0.00603, 0.00125, -0.00156));
+        assert_eq!(c.duration, 10987.5 * SECONDS_PER_SAMPLE);
     }
 }

@@ -2,7 +2,7 @@
 //! everything is kept in memory with its ground truth ([`SimRun`]).
 
 use crate::config::SimConfig;
-use crate::drive::Drive;
+use crate::drive::{Drive, DriveState};
 use crate::error::SimError;
 use crate::faults::SlipEpisode;
 use crate::kinematics::arc_motion;
@@ -12,6 +12,7 @@ use odocal_geom::Pose2;
 use odocal_log::{OdomRecord, ScanGeometry};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::collections::VecDeque;
 
 /// Independent random streams, so that enabling one feature (faults, noise) does not
 /// change the others (the same seed gives the same trajectory with or without faults).
@@ -54,7 +55,8 @@ pub struct SimEncoderRecord {
     pub dropped: bool,
 }
 
-/// One laser scan with the truth behind it.
+/// One laser scan with the truth behind it (for a swept scan: at ray 0, whose time
+/// the timestamp is).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimScan {
     /// Timestamp as logged (s, laser clock = encoder clock + clock offset).
@@ -65,6 +67,8 @@ pub struct SimScan {
     pub robot: Pose2,
     /// True sensor pose at acquisition: `robot ⊕ laser`.
     pub sensor: Pose2,
+    /// True sensor pose when the last ray was taken (equal to `sensor` without sweep).
+    pub sensor_at_last_ray: Pose2,
     /// True cumulative wheel rotations `[left, right]` (rad) at acquisition.
     pub wheel_angles: [f64; 2],
     /// The readings (m), 0 for failures.
@@ -177,6 +181,7 @@ pub fn simulate_in(config: &SimConfig, world: &World) -> Result<SimRun, SimError
     let mut encoders = Vec::with_capacity(encoder_times.len());
     let mut scans = Vec::with_capacity(scan_times.len());
     let (mut ei, mut si, mut slip_i) = (0, 0, 0);
+    let mut sweeps: VecDeque<Sweep> = VecDeque::new();
     loop {
         let t0 = drive.step_start_us();
         if t0 > duration_us {
@@ -206,19 +211,49 @@ pub fn simulate_in(config: &SimConfig, world: &World) -> Result<SimRun, SimError
             });
             ei += 1;
         }
-        while si < scan_times.len() && scan_times[si] < t1 {
-            let s = drive.state_at_us(scan_times[si]);
-            let sensor = s.pose.compose(&c.robot.laser);
-            scans.push(SimScan {
-                t: timestamp(start_us + scan_times[si] as i64 + offset_us),
-                t_true: timestamp(start_us + scan_times[si] as i64),
-                robot: s.pose,
-                sensor,
-                wheel_angles: s.wheel_angles,
-                ranges: c.laser.scan(world, &sensor, &mut noise),
-                dropped: is_dropped(&mut drops),
-            });
-            si += 1;
+        if c.laser.time_increment == 0.0 {
+            while si < scan_times.len() && scan_times[si] < t1 {
+                let s = drive.state_at_us(scan_times[si]);
+                let sensor = s.pose.compose(&c.robot.laser);
+                scans.push(SimScan {
+                    t: timestamp(start_us + scan_times[si] as i64 + offset_us),
+                    t_true: timestamp(start_us + scan_times[si] as i64),
+                    robot: s.pose,
+                    sensor,
+                    sensor_at_last_ray: sensor,
+                    wheel_angles: s.wheel_angles,
+                    ranges: c.laser.scan(world, &sensor, &mut noise),
+                    dropped: is_dropped(&mut drops),
+                });
+                si += 1;
+            }
+        } else {
+            while si < scan_times.len() && scan_times[si] < t1 {
+                sweeps.push_back(Sweep::new(scan_times[si], is_dropped(&mut drops)));
+                si += 1;
+            }
+            for sweep in sweeps.iter_mut() {
+                sweep.fire_rays_before(t1, &drive, c);
+            }
+            while sweeps
+                .front()
+                .is_some_and(|s| s.sensor_poses.len() == c.laser.num_rays)
+            {
+                let Some(sweep) = sweeps.pop_front() else {
+                    break;
+                };
+                let first = sweep.first.unwrap_or_else(|| drive.current());
+                scans.push(SimScan {
+                    t: timestamp(start_us + sweep.start_us as i64 + offset_us),
+                    t_true: timestamp(start_us + sweep.start_us as i64),
+                    robot: first.pose,
+                    sensor: sweep.sensor_poses[0],
+                    sensor_at_last_ray: sweep.sensor_poses[c.laser.num_rays - 1],
+                    wheel_angles: first.wheel_angles,
+                    ranges: c.laser.swept_scan(world, &sweep.sensor_poses, &mut noise),
+                    dropped: sweep.dropped,
+                });
+            }
         }
         drive.finish_step();
     }
@@ -232,6 +267,46 @@ pub fn simulate_in(config: &SimConfig, world: &World) -> Result<SimRun, SimError
         odom,
         slips,
     })
+}
+
+/// A scan being swept: the sensor's pose at each ray fired so far.
+struct Sweep {
+    /// Time of ray 0 (µs since the start).
+    start_us: u64,
+    /// The robot's state at ray 0.
+    first: Option<DriveState>,
+    /// Sensor pose (world) at each ray fired so far.
+    sensor_poses: Vec<Pose2>,
+    /// Left out of the log by the drop fault (drawn when the sweep starts, so that the
+    /// drop pattern does not depend on the sweep).
+    dropped: bool,
+}
+
+impl Sweep {
+    fn new(start_us: u64, dropped: bool) -> Self {
+        Sweep {
+            start_us,
+            first: None,
+            sensor_poses: Vec::new(),
+            dropped,
+        }
+    }
+
+    /// Fires the rays due before `end_us` (the end of the drive's current sub-step).
+    fn fire_rays_before(&mut self, end_us: u64, drive: &Drive, c: &SimConfig) {
+        let increment_us = c.laser.time_increment * 1e6;
+        while self.sensor_poses.len() < c.laser.num_rays {
+            let t = self.start_us as f64 + self.sensor_poses.len() as f64 * increment_us;
+            if t >= end_us as f64 {
+                break;
+            }
+            let s = drive.state_at_fractional_us(t);
+            if self.first.is_none() {
+                self.first = Some(s);
+            }
+            self.sensor_poses.push(s.pose.compose(&c.robot.laser));
+        }
+    }
 }
 
 /// Sample times (µs since the start) at `rate_hz` from `phase_us`, each moved by a

@@ -1,18 +1,20 @@
-//! The preset worlds: a Khepera arena, an office floor and a long featureless corridor.
+//! The preset worlds: a Khepera arena, an office floor, a long featureless corridor and
+//! a warehouse hall for fast robots.
 
 use crate::error::SimError;
 use crate::world::{Segment, World};
 
 /// Names accepted by [`World::preset`].
-pub const WORLD_NAMES: [&str; 3] = ["khepera-arena", "office", "corridor"];
+pub const WORLD_NAMES: [&str; 4] = ["khepera-arena", "office", "corridor", "hall"];
 
 impl World {
-    /// A preset world by name: `khepera-arena`, `office` or `corridor`.
+    /// A preset world by name: `khepera-arena`, `office`, `corridor` or `hall`.
     pub fn preset(name: &str) -> Result<World, SimError> {
         match name {
             "khepera-arena" | "arena" | "khepera_arena" => Ok(World::khepera_arena()),
             "office" => Ok(World::office()),
             "corridor" => Ok(World::corridor()),
+            "hall" | "warehouse" => Ok(World::hall()),
             _ => Err(SimError::UnknownName {
                 what: "world",
                 name: name.to_string(),
@@ -65,6 +67,41 @@ impl World {
     pub fn corridor() -> World {
         World::new("corridor", rect(0.0, 0.0, 40.0, 2.0)).with_home([20.0, 1.0])
     }
+
+    /// A 20 m × 12 m warehouse hall for robots driving at 0.5 m/s: shelf rows, pillars,
+    /// crates, a partition and two slanted corners, placed irregularly so that a 4 m
+    /// range finder sees several surfaces from anywhere inside and no two places look
+    /// alike.
+    pub fn hall() -> World {
+        let mut s = rect(0.0, 0.0, 20.0, 12.0);
+        // Slanted corners.
+        s.push(Segment::new([0.0, 9.8], [2.2, 12.0]));
+        s.push(Segment::new([17.6, 0.0], [20.0, 2.1]));
+        // Shelf rows.
+        s.extend(rect(2.0, 9.4, 6.2, 10.1));
+        s.extend(rect(8.0, 1.4, 8.7, 5.2));
+        s.extend(rect(12.6, 9.0, 17.0, 9.6));
+        s.extend(rect(16.4, 3.0, 17.1, 6.4));
+        // Pillars.
+        for (x, y) in [
+            (4.5, 5.5),
+            (11.0, 7.2),
+            (14.2, 3.6),
+            (3.2, 2.6),
+            (11.8, 1.9),
+            (10.3, 3.9),
+        ] {
+            s.extend(rect(x - 0.2, y - 0.2, x + 0.2, y + 0.2));
+        }
+        // Crates.
+        s.extend(rect(6.3, 6.9, 7.5, 7.8));
+        s.extend(rect(18.6, 9.2, 20.0, 10.6));
+        s.extend(rect(0.0, 5.2, 0.8, 6.6));
+        s.extend(rect(12.6, 4.9, 13.5, 5.6));
+        // A partition hanging from the north wall.
+        s.push(Segment::new([9.8, 12.0], [9.8, 9.6]));
+        World::new("hall", s).with_home([10.0, 6.0])
+    }
 }
 
 /// The four sides of the axis-aligned rectangle `[x0, x1] × [y0, y1]`.
@@ -86,6 +123,7 @@ mod tests {
         assert_eq!(World::khepera_arena().bounds(), [0.0, 0.0, 3.0, 2.5]);
         assert_eq!(World::office().bounds(), [0.0, 0.0, 10.0, 8.0]);
         assert_eq!(World::corridor().bounds(), [0.0, 0.0, 40.0, 2.0]);
+        assert_eq!(World::hall().bounds(), [0.0, 0.0, 20.0, 12.0]);
         for n in WORLD_NAMES {
             assert_eq!(World::preset(n).unwrap().name(), n);
         }

@@ -100,15 +100,19 @@ fn encoders_count_the_true_wheel_rotation_to_one_tick() {
     assert!((599..=601).contains(&r.scans.len()), "{}", r.scans.len());
 }
 
+/// The smallest distance (m) from the robot to a wall at the encoder records.
+fn closest_wall(r: &SimRun) -> f64 {
+    r.encoders
+        .iter()
+        .map(|e| r.world.clearance([e.robot.x, e.robot.y]))
+        .fold(f64::INFINITY, f64::min)
+}
+
 #[test]
 fn mixed_trajectories_keep_off_the_walls_in_every_world() {
     for preset in ["khepera", "office", "corridor"] {
         let r = run(preset, 14, 300.0, |c| c.laser.num_rays = 3);
-        let worst = r
-            .encoders
-            .iter()
-            .map(|e| r.world.clearance([e.robot.x, e.robot.y]))
-            .fold(f64::INFINITY, f64::min);
+        let worst = closest_wall(&r);
         assert!(worst > 0.19, "{preset}: came within {worst} m of a wall");
         let travelled: f64 = r
             .encoders
@@ -216,4 +220,72 @@ fn identical_turns_keep_one_curvature() {
         });
     assert!(max - min < 1e-9, "ratios from {min} to {max}");
     assert!((min - 1.0).abs() > 0.1, "not turning: ratio {min}");
+}
+
+#[test]
+fn swept_rays_are_taken_from_the_pose_at_their_own_time() {
+    for preset in ["turtlebot", "pioneer"] {
+        let r = run(preset, 15, 20.0, |c| {
+            c.laser = LaserConfig {
+                range_sigma: 0.0,
+                quantization: 0.0,
+                dropout_probability: 0.0,
+                ..c.laser.clone()
+            }
+        });
+        let laser = &r.config.laser;
+        assert!(laser.time_increment > 0.0, "{preset}: sweeps by default");
+        let angles = laser.angles();
+        let n = angles.len();
+        let (mut worst_ends, mut worst_inside, mut worst_unswept) = (0.0f64, 0.0f64, 0.0f64);
+        for s in &r.scans {
+            let (a, b) = (s.sensor, s.sensor_at_last_ray);
+            let turn = wrap_angle(b.theta - a.theta);
+            for (i, (r_i, angle)) in s.ranges.iter().zip(&angles).enumerate() {
+                if *r_i == 0.0 {
+                    continue;
+                }
+                let local = [*r_i as f64 * angle.cos(), *r_i as f64 * angle.sin()];
+                // The pose at the ray's time, interpolated between the first and the
+                // last ray (exact at both ends).
+                let u = i as f64 / (n - 1) as f64;
+                let pose = Pose2::new(
+                    a.x + u * (b.x - a.x),
+                    a.y + u * (b.y - a.y),
+                    a.theta + u * turn,
+                );
+                let off = r.world.clearance(pose.transform_point(local));
+                if i == 0 || i == n - 1 {
+                    worst_ends = worst_ends.max(off);
+                } else {
+                    worst_inside = worst_inside.max(off);
+                }
+                worst_unswept = worst_unswept.max(r.world.clearance(a.transform_point(local)));
+            }
+        }
+        assert!(
+            worst_ends < 2e-6,
+            "{preset}: first/last rays off by {worst_ends}"
+        );
+        assert!(worst_inside < 0.01, "{preset}: rays off by {worst_inside}");
+        assert!(
+            worst_unswept > 0.02,
+            "{preset}: all rays from the first pose fit within {worst_unswept}"
+        );
+    }
+}
+
+#[test]
+fn fast_robots_stay_off_the_walls_and_drive_fast() {
+    for (preset, fastest) in [("turtlebot", 0.16), ("pioneer", 0.4)] {
+        let r = run(preset, 16, 300.0, |c| c.laser.num_rays = 3);
+        let worst = closest_wall(&r);
+        assert!(worst > 0.19, "{preset}: came within {worst} m of a wall");
+        let top = r
+            .encoders
+            .windows(2)
+            .map(|w| w[0].robot.between(&w[1].robot).translation_norm() / (w[1].t - w[0].t))
+            .fold(0.0, f64::max);
+        assert!(top > fastest, "{preset}: top speed {top} m/s");
+    }
 }

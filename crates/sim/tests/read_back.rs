@@ -101,3 +101,31 @@ fn in_memory_log_matches_the_written_one() {
         assert_eq!((a.t, a.pose, a.tv, a.rv), (b.t, b.pose, b.tv, b.rv));
     }
 }
+
+#[test]
+fn swept_scans_read_back_with_their_time_increment() {
+    for (preset, laser) in [
+        ("turtlebot", "lds"),
+        ("pioneer", "urg-04lx"),
+        ("pioneer", "sick"),
+    ] {
+        let mut c = SimConfig::preset(preset).unwrap();
+        c.laser = odocal_sim::LaserConfig::model(laser).unwrap();
+        c.seed = 34;
+        c.duration = 3.0;
+        let (run, log, _) = written(&c);
+        let read = read_carmen_from(&log[..], "sim.log", &ReadOptions::default()).unwrap();
+        let dt = c.laser.time_increment;
+        assert!(dt > 0.0);
+        assert_eq!(read.params.laser_time_increment, Some(dt), "{laser}");
+        let mem = run.to_log();
+        assert_eq!(mem.params.laser_time_increment, Some(dt));
+        assert_eq!(mem.scans.len(), read.scans.len());
+        for (a, b) in mem.scans.iter().zip(read.scans.iter()) {
+            assert_eq!((a.t, a.ranges), (b.t, b.ranges));
+            assert!(a.geometry.same_rays(b.geometry), "{laser}");
+            assert_eq!(b.geometry.time_increment, dt);
+            assert_eq!(b.geometry.angles[..], c.laser.angles()[..]);
+        }
+    }
+}

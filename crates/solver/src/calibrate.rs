@@ -1,22 +1,25 @@
 //! The whole chain: checks, closed form (step 1 + step 2) with outlier trimming,
 //! noise estimate, maximum-likelihood refinement, covariance, observability.
 
+use crate::constraints::{Constraint, Constraints};
 use crate::covariance::{invert_information, Inversion};
 use crate::error::SolveError;
 use crate::kinematics::{residual_of, Predictor, RawOdometry};
 use crate::noise::{residual_sigmas, NoiseWeights};
-use crate::normal_equations::accumulate;
 use crate::observability::{
     information_not_excited, null_direction_names, parameter_reports, sentence, step1_not_excited,
     step2_not_excited, wheel_signs, MotionContent, Observability, Verdict,
 };
 use crate::packed::Packed;
 use crate::params::Params;
-use crate::refine::{refine, Refinement};
+use crate::partial::{step1_held, step2_held};
+use crate::refine::{constrained_normal_equations, refine, Refinement};
 use crate::sample::Sample;
+use crate::shared_scans::{score_covariance, SharedScanNoise};
 use crate::step1::{step1, Step1};
 use crate::step2::{build_m, solve_m, Step2, A_SINGULAR_CONDITION};
 use crate::trimming::Trim;
+use nalgebra::SMatrix;
 use serde::{Deserialize, Serialize};
 
 /// Fewest samples the solver accepts (input and after each trimming round).
@@ -30,8 +33,9 @@ pub const STEP1_SINGULAR_CONDITION: f64 = 1e12;
 /// Settings of [`calibrate`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SolveOptions {
-    /// Outlier trimming between closed-form solves (default: the original
-    /// package's rule, [`Trim::TRO`]).
+    /// Outlier trimming between closed-form solves (default: χ² on the residuals
+    /// whitened by their robust scale, [`Trim::CHI2`], which works at any sample
+    /// count; [`Trim::TRO`] is the original package's rule).
     pub trim: Trim,
     /// Refine all six parameters by maximum likelihood (default true).
     pub refine: bool,
@@ -42,6 +46,12 @@ pub struct SolveOptions {
     /// Which residuals the scan-matching σ's come from (default: as the original
     /// package, [`SigmaEstimate::FirstRound`]).
     pub sigma_from: SigmaEstimate,
+    /// Parameters held at known values or given priors (default: all free).
+    pub constraints: Constraints,
+    /// Return numbers even when the covariance says some parameters are not
+    /// excited (σ beyond the verdict's limit); by default that is an error. A
+    /// singular information matrix is an error regardless.
+    pub accept_weak: bool,
 }
 
 /// Which residuals `ŝ_pred − ŝ` the scan-matching standard deviations are estimated
@@ -61,11 +71,13 @@ pub enum SigmaEstimate {
 impl Default for SolveOptions {
     fn default() -> Self {
         SolveOptions {
-            trim: Trim::TRO,
+            trim: Trim::CHI2,
             refine: true,
             use_profile: true,
             weighted_step1: true,
             sigma_from: SigmaEstimate::FirstRound,
+            constraints: Constraints::default(),
+            accept_weak: false,
         }
     }
 }
@@ -125,6 +137,10 @@ pub struct Calibration {
     pub refinement: Option<Refinement>,
     /// Observability report.
     pub observability: Observability,
+    /// The noise shared by samples that share a scan, when the samples carry their
+    /// scans' times (the covariance then accounts for it); `None`: the samples
+    /// were treated as independent.
+    pub shared_scan_noise: Option<SharedScanNoise>,
 }
 
 /// Closed form (step 1 and step 2) on all `samples`, without trimming: the
@@ -136,6 +152,7 @@ pub fn closed_form(samples: &[Sample], use_profile: bool) -> Result<ClosedForm, 
     closed_form_packed(
         &Packed::all(samples, use_profile),
         None,
+        &Constraints::default(),
         &mut Scratch::default(),
     )
 }
@@ -149,14 +166,18 @@ struct Scratch {
     residuals: Vec<[f64; 3]>,
 }
 
-/// Closed form on packed samples; leaves the residuals `ŝ_pred − ŝ` in
-/// `scratch.residuals`.
+/// Closed form on packed samples with the held parameters of `held` (priors are
+/// ignored here); leaves the residuals `ŝ_pred − ŝ` in `scratch.residuals`.
 fn closed_form_packed(
     samples: &[Packed],
     theta_weights: Option<&[f64]>,
+    held: &Constraints,
     scratch: &mut Scratch,
 ) -> Result<ClosedForm, SolveError> {
     let s1 = step1(samples, theta_weights);
+    if (0..6).any(|i| held.is_held(i)) {
+        return closed_form_held(samples, theta_weights, held, s1, scratch);
+    }
     if s1.condition.is_nan()
         || s1.condition > STEP1_SINGULAR_CONDITION
         || !s1.j21.is_finite()
@@ -197,6 +218,76 @@ fn closed_form_packed(
     })
 }
 
+/// Residuals `ŝ_pred − ŝ` of packed samples at `params`.
+fn residuals_at(samples: &[Packed], params: &Params) -> Vec<[f64; 3]> {
+    let pred = Predictor::new(params, true);
+    samples
+        .iter()
+        .map(|s| residual_of(pred.predict_pieces(s.pieces()), &s.sm))
+        .collect()
+}
+
+/// The closed form with some parameters held (see [`crate::partial`]).
+fn closed_form_held(
+    samples: &[Packed],
+    theta_weights: Option<&[f64]>,
+    held: &Constraints,
+    s1: Step1,
+    scratch: &mut Scratch,
+) -> Result<ClosedForm, SolveError> {
+    let (j21, j22) = step1_held(samples, theta_weights, held, &s1)?;
+    let s2 = step2_held(samples, j21, j22, held, &s1, &mut scratch.unit)?;
+    let params = held.apply_held(&Params {
+        r_l: -s2.b * j21,
+        r_r: s2.b * j22,
+        b: s2.b,
+        laser: s2.laser,
+    });
+    let pred = Predictor::new(&params, true);
+    scratch.residuals.clear();
+    scratch.residuals.extend(
+        samples
+            .iter()
+            .map(|s| residual_of(pred.predict_pieces(s.pieces()), &s.sm)),
+    );
+    Ok(ClosedForm {
+        params,
+        step1: Step1 { j21, j22, ..s1 },
+        step2: s2,
+    })
+}
+
+/// `H⁻¹ (M + P) H⁻¹`: the covariance of the estimate when the score `Σ GᵀWe` has
+/// covariance `M` (not `H`: samples sharing scans) and the priors add their
+/// information `P`. `inverse` is `H⁻¹` with held rows zero.
+fn sandwich(
+    inverse: &[[f64; 6]; 6],
+    score: &[[f64; 6]; 6],
+    constraints: &Constraints,
+) -> [[f64; 6]; 6] {
+    let mut meat = *score;
+    for (i, c) in constraints.0.iter().enumerate() {
+        if let Constraint::Prior { sigma, .. } = c {
+            meat[i][i] += 1.0 / (sigma * sigma);
+        }
+    }
+    let hi = SMatrix::<f64, 6, 6>::from_fn(|i, j| inverse[i][j]);
+    let m = SMatrix::<f64, 6, 6>::from_fn(|i, j| meat[i][j]);
+    let c = hi * m * hi;
+    std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (c[(i, j)] + c[(j, i)])))
+}
+
+/// The covariance with the rows and columns of held parameters set to zero.
+fn zero_held_rows(mut c: [[f64; 6]; 6], constraints: &Constraints) -> [[f64; 6]; 6] {
+    for i in (0..6).filter(|&i| constraints.is_held(i)) {
+        for j in 0..6 {
+            c[i][j] = 0.0;
+            c[j][i] = 0.0;
+        }
+    }
+    c
+}
+
 /// Calibrates: the six parameters, their covariance and the observability report.
 pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibration, SolveError> {
     for (k, s) in samples.iter().enumerate() {
@@ -224,17 +315,38 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     let mut active = Packed::all(samples, options.use_profile);
     let mut samples_per_round = vec![active.len()];
     let mut scratch = Scratch::default();
-    let mut cf = closed_form_packed(&active, tw, &mut scratch)?;
+    // Held parameters enter the closed form; priors only the refinement, unless the
+    // data alone do not determine the closed form: then it holds the priors' means.
+    let constraints = options.constraints;
+    let mut held = constraints;
+    let mut cf = match closed_form_packed(&active, tw, &held, &mut scratch) {
+        Err(SolveError::NotExcited { .. }) if constraints.has_priors() => {
+            held = constraints.priors_held();
+            closed_form_packed(&active, tw, &held, &mut scratch)?
+        }
+        other => other?,
+    };
     // Scan-matching noise as the original package estimates it: residuals of the
     // first (untrimmed) closed-form estimate over the samples kept after the first
     // trimming round (all samples when there is no trimming).
     let mut noise_residuals: Option<Vec<[f64; 3]>> = None;
+    // Rules that judge every sample at the current estimate (samples may come back)
+    // stop when the kept set no longer changes; the others drop from the active set.
+    let whole = options.trim.judges_all_samples();
+    let all = if whole { active.clone() } else { Vec::new() };
+    let mut previous = vec![true; all.len()];
     for round in 0..options.trim.rounds() {
-        let keep = options.trim.keep(&scratch.residuals);
+        let at_estimate;
+        let residuals: &[[f64; 3]] = if whole {
+            at_estimate = residuals_at(&all, &cf.params);
+            &at_estimate
+        } else {
+            &scratch.residuals
+        };
+        let keep = options.trim.keep(residuals);
         if round == 0 {
             noise_residuals = Some(
-                scratch
-                    .residuals
+                residuals
                     .iter()
                     .zip(&keep)
                     .filter(|(_, &k)| k)
@@ -242,8 +354,21 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
                     .collect(),
             );
         }
-        let mut kept = keep.iter();
-        active.retain(|_| kept.next().copied().unwrap_or(false));
+        if whole {
+            if keep == previous {
+                break;
+            }
+            active = all
+                .iter()
+                .zip(&keep)
+                .filter(|(_, &k)| k)
+                .map(|(p, _)| *p)
+                .collect();
+            previous = keep;
+        } else {
+            let mut kept = keep.iter();
+            active.retain(|_| kept.next().copied().unwrap_or(false));
+        }
         samples_per_round.push(active.len());
         if active.len() < MIN_SAMPLES {
             return Err(SolveError::TooFewSamples {
@@ -252,7 +377,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
                 stage: format!("after trimming round {}", round + 1),
             });
         }
-        cf = closed_form_packed(&active, tw, &mut scratch)?;
+        cf = closed_form_packed(&active, tw, &held, &mut scratch)?;
     }
     let sm_sigma = match options.sigma_from {
         SigmaEstimate::FirstRound => {
@@ -269,10 +394,10 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // The last pass of the refinement (or one pass at the closed form) gives the
     // cost and the Fisher information at the estimate.
     let (params, refinement, cost_before, cost_after, information) = if options.refine {
-        let (r, h) = refine(&active, &cf.params, &weights);
+        let (r, h) = refine(&active, &cf.params, &weights, &constraints);
         (r.params, Some(r), r.cost_before, r.cost_after, h)
     } else {
-        let ne = accumulate(&active, &cf.params, &weights);
+        let ne = constrained_normal_equations(&active, &cf.params, &weights, &constraints);
         (cf.params, None, ne.cost, ne.cost, ne.h)
     };
     if !params.to_vector().iter().all(|v| v.is_finite()) {
@@ -284,8 +409,14 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // Motion classes with the estimated radii; for the "not excited" errors, where
     // the estimate is not trustworthy, with equal radii.
     let motion_equal_radii = || MotionContent::classify(&active, 1.0, 1.0);
-    let covariance = match invert_information(&information) {
-        Inversion::Covariance(c) => *c,
+    let (covariance, shared_scan_noise) = match invert_information(&information) {
+        Inversion::Covariance(c) => {
+            let inverse = zero_held_rows(*c, &constraints);
+            match score_covariance(&active, &params, &weights) {
+                Some((score, model)) => (sandwich(&inverse, &score, &constraints), Some(model)),
+                None => (inverse, None),
+            }
+        }
         Inversion::Singular(null) => {
             return Err(information_not_excited(
                 null_direction_names(&null),
@@ -293,13 +424,13 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
             ))
         }
     };
-    let reports = parameter_reports(&params, &covariance);
+    let reports = parameter_reports(&params, &covariance, &constraints);
     let not_excited: Vec<String> = reports
         .iter()
         .filter(|r| r.verdict == Verdict::NotExcited)
         .map(|r| r.name.clone())
         .collect();
-    if !not_excited.is_empty() {
+    if !not_excited.is_empty() && !options.accept_weak {
         return Err(information_not_excited(not_excited, &motion_equal_radii()));
     }
     let motion = MotionContent::classify(&active, params.r_l, params.r_r);
@@ -331,5 +462,6 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         reduced_chi2: cost_after / (3 * active.len()).saturating_sub(6).max(1) as f64,
         refinement,
         observability,
+        shared_scan_noise,
     })
 }

@@ -43,6 +43,7 @@
 #![allow(clippy::needless_range_loop)]
 
 mod calibrate;
+mod constraints;
 mod covariance;
 mod error;
 mod kinematics;
@@ -52,8 +53,10 @@ mod normal_equations;
 mod observability;
 mod packed;
 mod params;
+mod partial;
 pub mod refine;
 mod sample;
+mod shared_scans;
 pub mod step1;
 pub mod step2;
 pub mod trimming;
@@ -62,12 +65,19 @@ pub use calibrate::{
     calibrate, closed_form, Calibration, ClosedForm, NoiseSource, SigmaEstimate, SolveOptions,
     MIN_SAMPLES, STEP1_SINGULAR_CONDITION,
 };
+pub use constraints::{
+    parameter_index, parse_fix, parse_prior, Constraint, ConstraintError, Constraints,
+};
 pub use covariance::INFORMATION_SINGULAR_RATIO;
 pub use error::SolveError;
 pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
-pub use observability::{MotionContent, Observability, ParameterReport, Verdict};
+pub use observability::{
+    MotionContent, Observability, ParameterReport, Verdict, MOTION_CLASS_RATIO,
+    PARTIAL_CALIBRATION_HINT,
+};
 pub use params::{Params, PARAMETER_NAMES};
 pub use refine::Refinement;
 pub use sample::{ProfileSegment, Sample};
+pub use shared_scans::{SharedScanNoise, MIN_SHARED_SCANS};
 pub use trimming::Trim;

@@ -3,6 +3,7 @@
 //! a sentence saying which motion is missing, and detection of reversed or swapped
 //! wheel encoders. Also builds the "not excited" errors for degenerate data.
 
+use crate::constraints::{Constraint, Constraints};
 use crate::error::SolveError;
 use crate::packed::Packed;
 use crate::params::{Params, PARAMETER_NAMES};
@@ -59,6 +60,8 @@ pub struct ParameterReport {
     pub sigma: f64,
     /// The verdict.
     pub verdict: Verdict,
+    /// Held at a known value, given a prior, or estimated from the data alone.
+    pub constraint: Constraint,
 }
 
 /// How many samples contain each kind of motion (classified from the wheel
@@ -119,7 +122,7 @@ impl MotionContent {
         out
     }
 
-    fn describe(&self) -> String {
+    pub(crate) fn describe(&self) -> String {
         format!(
             "{} spins in place, {} straight, {} turning while translating, {} still",
             self.spins, self.straight, self.turning_while_translating, self.still
@@ -167,8 +170,13 @@ fn verdict(index: usize, value: f64, sigma: f64, b: f64) -> Verdict {
     }
 }
 
-/// Per-parameter reports from the estimate and its covariance.
-pub fn parameter_reports(params: &Params, covariance: &[[f64; 6]; 6]) -> Vec<ParameterReport> {
+/// Per-parameter reports from the estimate and its covariance (held parameters,
+/// with zero variance, are "well determined").
+pub fn parameter_reports(
+    params: &Params,
+    covariance: &[[f64; 6]; 6],
+    constraints: &Constraints,
+) -> Vec<ParameterReport> {
     let v = params.to_vector();
     (0..6)
         .map(|i| {
@@ -177,7 +185,12 @@ pub fn parameter_reports(params: &Params, covariance: &[[f64; 6]; 6]) -> Vec<Par
                 name: PARAMETER_NAMES[i].to_string(),
                 value: v[i],
                 sigma,
-                verdict: verdict(i, v[i], sigma, params.b),
+                verdict: if constraints.is_held(i) {
+                    Verdict::WellDetermined
+                } else {
+                    verdict(i, v[i], sigma, params.b)
+                },
+                constraint: constraints.0[i],
             }
         })
         .collect()
@@ -373,7 +386,7 @@ pub(crate) fn step2_not_excited(
     let refs: Vec<&str> = parameters.iter().map(|s| s.as_str()).collect();
     SolveError::NotExcited {
         sentence: format!(
-            "the motion does not excite them ({}); {}",
+            "the motion does not excite them ({}); {}; {PARTIAL_CALIBRATION_HINT}",
             motion.describe(),
             advice(&refs, &motion)
         ),
@@ -394,13 +407,18 @@ pub(crate) fn information_not_excited(
     let refs: Vec<&str> = parameters.iter().map(|s| s.as_str()).collect();
     SolveError::NotExcited {
         sentence: format!(
-            "the motion does not excite them ({}); {}",
+            "the motion does not excite them ({}); {}; {PARTIAL_CALIBRATION_HINT}",
             motion.describe(),
             advice(&refs, motion)
         ),
         parameters,
     }
 }
+
+/// What a refusal suggests when some of the parameters concerned are known
+/// from elsewhere (a datasheet, a measurement, another calibration).
+pub const PARTIAL_CALIBRATION_HINT: &str = "if some of them are known, hold them with \
+     --fix NAME=VALUE or give a prior with --prior NAME=VALUE±SIGMA (SI units)";
 
 /// Names of the parameters involved in the null directions of the information.
 pub(crate) fn null_direction_names(null: &[[f64; 6]]) -> Vec<String> {
@@ -432,7 +450,7 @@ mod tests {
         for i in 0..6 {
             cov[i][i] = sigmas[i] * sigmas[i];
         }
-        let v: Vec<Verdict> = parameter_reports(&p, &cov)
+        let v: Vec<Verdict> = parameter_reports(&p, &cov, &Constraints::default())
             .iter()
             .map(|r| r.verdict)
             .collect();

@@ -1,9 +1,10 @@
-//! Maximum-likelihood refinement of all six parameters: Levenberg–Marquardt on the
+//! Maximum-likelihood refinement of the six parameters (those not held): Levenberg–Marquardt on the
 //! weighted residuals `ŝ_pred − ŝ`, started from the closed form.
 
+use crate::constraints::Constraints;
 use crate::linalg::unit_diagonal;
 use crate::noise::NoiseWeights;
-use crate::normal_equations::accumulate;
+use crate::normal_equations::{accumulate, NormalEquations};
 use crate::packed::Packed;
 use crate::params::Params;
 use nalgebra::{SMatrix, SVector};
@@ -30,15 +31,30 @@ pub struct Refinement {
     pub converged: bool,
 }
 
-/// Refines `start` over `samples`; also returns the Gauss–Newton matrix
-/// (Fisher information) at the refined parameters.
+/// The normal equations at `params` with the priors added and the held parameters
+/// decoupled.
+pub(crate) fn constrained_normal_equations(
+    samples: &[Packed],
+    params: &Params,
+    weights: &NoiseWeights,
+    constraints: &Constraints,
+) -> NormalEquations {
+    let mut ne = accumulate(samples, params, weights);
+    constraints.apply_to(&mut ne, params);
+    ne
+}
+
+/// Refines `start` over `samples` (held parameters stay put, priors add their
+/// terms to the cost); also returns the Gauss–Newton matrix (Fisher information,
+/// priors included, held rows decoupled) at the refined parameters.
 pub(crate) fn refine(
     samples: &[Packed],
     start: &Params,
     weights: &NoiseWeights,
+    constraints: &Constraints,
 ) -> (Refinement, [[f64; 6]; 6]) {
-    let mut params = *start;
-    let mut ne = accumulate(samples, &params, weights);
+    let mut params = constraints.apply_held(start);
+    let mut ne = constrained_normal_equations(samples, &params, weights, constraints);
     let cost_before = ne.cost;
     let mut lambda = 1e-6;
     let mut iterations = 0;
@@ -72,8 +88,8 @@ pub(crate) fn refine(
         for i in 0..6 {
             v[i] += step_scaled[i] * s[i];
         }
-        let trial = Params::from_vector(v);
-        let trial_ne = accumulate(samples, &trial, weights);
+        let trial = constraints.apply_held(&Params::from_vector(v));
+        let trial_ne = constrained_normal_equations(samples, &trial, weights, constraints);
         if trial_ne.cost.is_finite() && trial_ne.cost <= ne.cost {
             let decrease = ne.cost - trial_ne.cost;
             params = trial;

@@ -76,6 +76,20 @@ pub(crate) fn build_m(
     ]
 }
 
+/// Condition numbers of the block `A` of `M` (raw and with unit diagonal) and the
+/// direction of `(b, ℓx, ℓy)` it excites least.
+pub(crate) fn a_conditions(m: &[[f64; 5]; 5]) -> (f64, f64, [f64; 3]) {
+    let a = Matrix3::from_fn(|i, j| m[i][j]);
+    let (a_scaled, _) = unit_diagonal(&a);
+    let (raw_eigs, _) = symmetric_eigen_sorted(&a);
+    let (scaled_eigs, scaled_vecs) = symmetric_eigen_sorted(&a_scaled);
+    (
+        condition_from_eigenvalues(&raw_eigs),
+        condition_from_eigenvalues(&scaled_eigs),
+        [scaled_vecs[0][0], scaled_vecs[0][1], scaled_vecs[0][2]],
+    )
+}
+
 /// Minimises `xᵀMx` subject to `x4² + x5² = 1`, `x1 > 0`. Returns `None` only
 /// when `A` is not positive definite at all; ill-conditioning is reported in the
 /// result's condition numbers.
@@ -85,11 +99,7 @@ pub fn solve_m(m: &[[f64; 5]; 5]) -> Option<Step2> {
     let c = Matrix2::from_fn(|i, j| m[i + 3][j + 3]);
 
     let (a_scaled, scale) = unit_diagonal(&a);
-    let (raw_eigs, _) = symmetric_eigen_sorted(&a);
-    let (scaled_eigs, scaled_vecs) = symmetric_eigen_sorted(&a_scaled);
-    let a_condition = condition_from_eigenvalues(&raw_eigs);
-    let a_condition_scaled = condition_from_eigenvalues(&scaled_eigs);
-    let a_weakest_direction = [scaled_vecs[0][0], scaled_vecs[0][1], scaled_vecs[0][2]];
+    let (a_condition, a_condition_scaled, a_weakest_direction) = a_conditions(m);
     if scale.contains(&0.0) {
         return None;
     }

@@ -1,10 +1,13 @@
 //! The report of a calibration: what `--json` prints and `results.json` holds, and
 //! the human summary.
 
-use crate::run::{Options, Outcome, Timing};
-use crate::sync::DiscardCounts;
+use crate::finding::{Finding, Severity};
+use crate::provenance::Provenance;
 use odocal_log::Log;
-use odocal_solver::{Observability, PARAMETER_NAMES};
+use odocal_pipeline::consistency::Consistency;
+use odocal_pipeline::sync::DiscardCounts;
+use odocal_pipeline::{Estimate, Options, Outcome, Timing};
+use odocal_solver::{Constraint, Observability, SharedScanNoise, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
 use std::path::Path;
@@ -16,6 +19,8 @@ pub struct Report {
     pub log: String,
     /// What the reader found in it.
     pub log_contents: LogContents,
+    /// The data-health findings: each fault found, what was done, what the user can do.
+    pub health: Vec<odocal_pipeline::Finding>,
     /// Left wheel radius (m).
     pub r_l: f64,
     /// Right wheel radius (m).
@@ -60,9 +65,31 @@ pub struct Report {
     pub cost_after: f64,
     /// Observability verdicts.
     pub observability: Observability,
+    /// The two halves of the samples calibrated separately and compared.
+    pub consistency: Consistency,
+    /// The noise shared by consecutive samples (through their common scan) that the
+    /// covariance accounts for; absent when the samples were treated as independent.
+    pub shared_scan_noise: Option<SharedScanNoise>,
     /// Estimated clock offset (s, laser clock minus encoder clock), when asked.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_s: Option<f64>,
+    /// The nominal parameters given (`--nominal`), order r_L, r_R, b, ℓx, ℓy, ℓθ.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal: Option<[f64; 6]>,
+    /// With nominal values: `estimate / nominal` of r_L, r_R and b, what to multiply
+    /// the robot's configured values by.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub correction_factors: Option<[f64; 3]>,
+    /// Consistency checks of the result (e.g. the two halves of the log agree).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub checks: Vec<Finding>,
+    /// Command line, version, input checksum and wall time, when the caller gives them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<Provenance>,
+    /// Duration of one laser sweep (s), when the rays were taken one after another and
+    /// the sweep was compensated before matching.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep_compensated_s: Option<f64>,
     /// Trimming rule, refinement, profile use.
     pub settings: Settings,
     /// Wall time per stage (s).
@@ -102,20 +129,40 @@ pub struct Settings {
     pub second_pass: bool,
     /// Clock offset applied when not estimated (s).
     pub time_offset_s: f64,
+    /// Per parameter (r_L, r_R, b, l_x, l_y, l_theta): "free", {"held": value}
+    /// (`--fix`) or {"prior": {"mean", "sigma"}} (`--prior`).
+    pub constraints: odocal_solver::Constraints,
+    /// Numbers returned even for weakly determined parameters (`--accept-weak`).
+    pub accept_weak: bool,
+}
+
+/// The two-halves check as a finding: a note when the halves agree or could not
+/// be checked, a warning when they disagree beyond 3σ.
+fn two_halves(c: &Consistency) -> Finding {
+    let (severity, message) = match c {
+        Consistency::Checked(h) if h.agree => (Severity::Info, h.sentence.clone()),
+        Consistency::Checked(h) => (Severity::Warning, h.sentence.clone()),
+        Consistency::NotAvailable { reason } => (
+            Severity::Info,
+            format!("the two halves of the log were not compared: {reason}"),
+        ),
+    };
+    Finding {
+        kind: "two_halves".into(),
+        severity,
+        count: 1,
+        first_line: None,
+        time: None,
+        spans: Vec::new(),
+        message,
+    }
 }
 
 /// Builds the report of a finished calibration.
 pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -> Report {
     let c = &outcome.calibration;
-    let v = c.params.to_vector();
-    let sigma: [f64; 6] = std::array::from_fn(|i| c.covariance[i][i].max(0.0).sqrt());
-    let mut intervals: Vec<f64> = outcome.synced.samples.iter().map(|s| s.wheel.dt).collect();
-    let interval_s = if intervals.is_empty() {
-        f64::NAN
-    } else {
-        let mid = intervals.len() / 2;
-        *intervals.select_nth_unstable_by(mid, f64::total_cmp).1
-    };
+    let e = Estimate::of(outcome);
+    let v = e.params;
     Report {
         log: path.display().to_string(),
         log_contents: LogContents {
@@ -125,29 +172,45 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             first_skipped: log.stats.first_skipped.clone(),
             unknown_messages: log.stats.unknown.values().sum(),
         },
+        health: outcome.health.clone(),
         r_l: v[0],
         r_r: v[1],
         b: v[2],
         l_x: v[3],
         l_y: v[4],
         l_theta: v[5],
-        sigma,
-        covariance: c.covariance,
-        j: c.j,
+        sigma: e.sigma,
+        covariance: e.covariance,
+        j: e.j,
         closed_form: c.closed_form.to_vector(),
-        samples_used: c.samples_used,
-        samples_synchronized: outcome.synced.samples.len(),
+        samples_used: e.samples_used,
+        samples_synchronized: e.samples_synchronized,
         samples_trimmed: outcome.synced.samples.len().saturating_sub(c.samples_used),
         scan_pairs: outcome.synced.pairs,
         discarded: outcome.synced.discarded.clone(),
-        stride: outcome.synced.stride,
-        interval_s,
+        stride: e.stride,
+        interval_s: e.interval_s,
         ticks_per_revolution: outcome.synced.ticks_per_revolution,
         sm_sigma: c.sm_sigma,
         cost_before: c.cost_before,
         cost_after: c.cost_after,
         observability: c.observability.clone(),
+        consistency: outcome.consistency.clone(),
+        shared_scan_noise: c.shared_scan_noise,
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
+        nominal: opts.initial_params.map(|p| p.to_vector()),
+        correction_factors: opts
+            .initial_params
+            .map(|n| [v[0] / n.r_l, v[1] / n.r_r, v[2] / n.b]),
+        checks: vec![two_halves(&outcome.consistency)],
+        provenance: None,
+        sweep_compensated_s: outcome.synced.sweep_compensated.then(|| {
+            log.scans
+                .geometries
+                .iter()
+                .map(|g| g.sweep_duration().abs())
+                .fold(0.0, f64::max)
+        }),
         settings: Settings {
             trim: opts.solve.trim,
             refine: opts.solve.refine,
@@ -162,8 +225,10 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             },
             second_pass: opts.second_pass,
             time_offset_s: opts.time_offset,
+            constraints: opts.solve.constraints,
+            accept_weak: opts.solve_options().accept_weak,
         },
-        timing_s: outcome.timing,
+        timing_s: e.timing_s,
     }
 }
 
@@ -192,6 +257,9 @@ impl fmt::Display for Report {
                 lines.join(", ")
             )?;
         }
+        for finding in &self.health {
+            writeln!(f, "  {finding}")?;
+        }
         writeln!(f)?;
         let v = self.values();
         for i in 0..6 {
@@ -199,8 +267,14 @@ impl fmt::Display for Report {
                 .observability
                 .parameters
                 .get(i)
-                .map(|p| p.verdict.as_str())
-                .unwrap_or("");
+                .map(|p| match p.constraint {
+                    Constraint::Free => p.verdict.as_str().to_string(),
+                    Constraint::Held(_) => "held (--fix)".to_string(),
+                    Constraint::Prior { mean, sigma } => {
+                        format!("{} (prior {mean} ± {sigma})", p.verdict.as_str())
+                    }
+                })
+                .unwrap_or_default();
             if i == 5 {
                 writeln!(
                     f,
@@ -254,6 +328,17 @@ impl fmt::Display for Report {
             self.sm_sigma[1] * 1e3,
             self.sm_sigma[2].to_degrees()
         )?;
+        if let Some(n) = &self.shared_scan_noise {
+            writeln!(
+                f,
+                "  shared by consecutive samples through their common scan: {:.0} %, {:.0} %, {:.0} % \
+                 of it (x, y, θ; {} shared scans), accounted for in the σ above",
+                100.0 * n.shared_fraction[0],
+                100.0 * n.shared_fraction[1],
+                100.0 * n.shared_fraction[2],
+                n.shared_scans
+            )?;
+        }
         writeln!(
             f,
             "  cost: {:.4e} (closed form) → {:.4e}",
@@ -268,12 +353,29 @@ impl fmt::Display for Report {
         if let Some(w) = &o.wheel_signs {
             writeln!(f, "  warning: {w}")?;
         }
+        if let Some(t) = self.sweep_compensated_s {
+            writeln!(
+                f,
+                "  sweep: {:.1} ms per scan, compensated (rays moved to mid-sweep with the wheel motion)",
+                t * 1e3
+            )?;
+        }
         if let Some(t) = self.time_offset_s {
             writeln!(
                 f,
                 "  clock offset (laser clock − encoder clock): {:+.4} s",
                 t
             )?;
+        }
+        if let Some(c) = self.correction_factors {
+            writeln!(
+                f,
+                "  correction factors (calibrated / nominal): r_L ×{:.6}, r_R ×{:.6}, b ×{:.6}",
+                c[0], c[1], c[2]
+            )?;
+        }
+        for finding in &self.checks {
+            writeln!(f, "  {finding}")?;
         }
         let t = &self.timing_s;
         writeln!(

@@ -1,0 +1,151 @@
+//! A quick check of the laser–encoder clock offset on every run: the robot's rotation
+//! over each pair seen by scan matching is compared with the wheels' rotation
+//! difference over the same interval shifted by δ; the δ at which they correlate best
+//! is where the clocks agree. It costs a few interpolations per sample and grid point,
+//! not a solve.
+
+use super::{FaultKind, Finding, Severity};
+use crate::run::{Options, Synchronized};
+use crate::sync::EncoderTrack;
+use odocal_log::Log;
+
+/// Half-width (s) of the quick check's search around the offset in use.
+pub const QUICK_RANGE_S: f64 = 2.0;
+/// Grid step (s) of the quick check.
+pub const QUICK_STEP_S: f64 = 0.01;
+/// An offset further than this (s) from the one in use is reported.
+pub const LARGE_OFFSET_S: f64 = 0.05;
+/// At most this many samples enter the quick check.
+const MAX_SAMPLES: usize = 1000;
+
+/// The quick check's answer.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuickOffset {
+    /// The offset (s, laser clock minus encoder clock) of best agreement.
+    pub offset: f64,
+    /// Correlation of the two rotations there.
+    pub correlation: f64,
+    /// Correlation at the offset in use.
+    pub correlation_in_use: f64,
+}
+
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    let d = (saa * sbb).sqrt();
+    if d > 0.0 {
+        sab / d
+    } else {
+        f64::NAN
+    }
+}
+
+/// The offset within `center ± range` at which scan-matching rotations and wheel
+/// rotation differences correlate best; `None` with too few samples.
+pub fn quick_estimate(
+    log: &Log,
+    synced: &Synchronized,
+    center: f64,
+    range: f64,
+) -> Option<QuickOffset> {
+    let (first, last) = (log.encoders.first()?.t, log.encoders.last()?.t);
+    let every = synced.samples.len().div_ceil(MAX_SAMPLES).max(1);
+    // Samples whose shifted intervals stay inside the encoder stream at every δ.
+    let used: Vec<_> = synced
+        .samples
+        .iter()
+        .step_by(every)
+        .filter(|s| s.pair.t0 - center - range > first && s.pair.t1 - center + range < last)
+        .collect();
+    if used.len() < 20 {
+        return None;
+    }
+    let track = EncoderTrack::new(&log.encoders, synced.ticks_per_revolution);
+    let theta: Vec<f64> = used.iter().map(|s| s.icp.pose.theta).collect();
+    let rotation_at = |delta: f64| -> Option<Vec<f64>> {
+        used.iter()
+            .map(|s| {
+                let (l0, r0) = track.ticks_at(s.pair.t0 - delta, f64::INFINITY).ok()?;
+                let (l1, r1) = track.ticks_at(s.pair.t1 - delta, f64::INFINITY).ok()?;
+                Some((r1 - r0) - (l1 - l0))
+            })
+            .collect()
+    };
+    let n = (range / QUICK_STEP_S).round() as i64;
+    let grid: Vec<(f64, f64)> = (-n..=n)
+        .filter_map(|i| {
+            let d = center + i as f64 * QUICK_STEP_S;
+            let c = correlation(&theta, &rotation_at(d)?);
+            c.is_finite().then_some((d, c))
+        })
+        .collect();
+    let (k, &(best, corr)) = grid
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1 .1.total_cmp(&b.1 .1))?;
+    // Parabola through the best grid point and its neighbours.
+    let offset = match (k.checked_sub(1).and_then(|j| grid.get(j)), grid.get(k + 1)) {
+        (Some(&(_, a)), Some(&(_, c))) if a - 2.0 * corr + c < 0.0 => {
+            best + 0.5 * QUICK_STEP_S * (a - c) / (a - 2.0 * corr + c)
+        }
+        _ => best,
+    };
+    let in_use = correlation(&theta, &rotation_at(center)?);
+    Some(QuickOffset {
+        offset,
+        correlation: corr,
+        correlation_in_use: in_use,
+    })
+}
+
+/// The disagreement `1 − correlation` at the offset in use must be at least this many
+/// times that at the best offset for the offset to be reported (outliers such as slip
+/// move the best offset a little without such a gain).
+pub const MIN_GAIN: f64 = 1.5;
+
+/// True when the quick estimate says the clocks are clearly offset from `in_use`.
+pub fn is_large(q: &QuickOffset, in_use: f64) -> bool {
+    (q.offset - in_use).abs() > LARGE_OFFSET_S
+        && q.correlation > 0.5
+        && (1.0 - q.correlation_in_use) >= MIN_GAIN * (1.0 - q.correlation)
+}
+
+/// The finding of the quick check, when the clocks look offset and no estimate was
+/// asked for.
+pub fn quick_check(log: &Log, synced: &Synchronized, opts: &Options) -> Option<Finding> {
+    if opts.estimate_time_offset.is_some() {
+        return None;
+    }
+    let used = synced.time_offset;
+    let q = quick_estimate(log, synced, used, QUICK_RANGE_S)?;
+    if !is_large(&q, used) {
+        return None;
+    }
+    let range = suggested_range(q.offset - used);
+    Some(Finding {
+        kind: FaultKind::ClockOffset,
+        severity: Severity::Warning,
+        count: 1,
+        first_line: None,
+        time: None,
+        message: format!(
+            "the laser clock looks offset from the encoder clock by about {:+.2} s \
+             (rotations from scan matching and from the wheels agree best there: \
+             correlation {:.3} against {:.3} at the {used:+.2} s used); the results are \
+             biased unless the offset is applied: pass `--estimate-time-offset \
+             --time-offset-range {range}` or `--time-offset {:.2}`",
+            q.offset, q.correlation, q.correlation_in_use, q.offset
+        ),
+    })
+}
+
+/// A search half-width (s) that comfortably holds an offset `d` from the start.
+pub fn suggested_range(d: f64) -> f64 {
+    ((d.abs() * 1.5 + 0.1) * 10.0).ceil() / 10.0
+}

@@ -1,0 +1,175 @@
+//! Records logged twice (identical, dropped) and different records sharing one
+//! timestamp (timestamps rounded by the logger: encoder records merged, scans kept
+//! once), which would otherwise be used twice or give zero-length intervals.
+
+use super::{FaultKind, Finding, Severity};
+use odocal_log::{EncoderRecord, ScanMeta, ScanStore};
+
+/// True when two scans have the same geometry and bit-identical ranges.
+pub(crate) fn same_ranges(store: &ScanStore, a: &ScanMeta, b: &ScanMeta) -> bool {
+    if a.geometry != b.geometry {
+        return false;
+    }
+    let n = store
+        .geometries
+        .get(a.geometry as usize)
+        .map_or(0, |g| g.num_readings());
+    match (
+        store.ranges.get(a.offset..a.offset + n),
+        store.ranges.get(b.offset..b.offset + n),
+    ) {
+        (Some(x), Some(y)) => x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits()),
+        _ => false,
+    }
+}
+
+/// The smallest positive step between consecutive distinct timestamps (s).
+fn resolution(times: impl Iterator<Item = f64>) -> f64 {
+    let mut prev: Option<f64> = None;
+    let mut best = f64::INFINITY;
+    for t in times {
+        if let Some(p) = prev {
+            if t > p {
+                best = best.min(t - p);
+            }
+        }
+        prev = Some(t);
+    }
+    best
+}
+
+/// Drops exact repeats of encoder records and merges records sharing a timestamp into
+/// one (their mean count). `records` is sorted by time.
+pub fn encoders(records: &mut Vec<EncoderRecord>) -> Vec<Finding> {
+    let mut out: Vec<EncoderRecord> = Vec::with_capacity(records.len());
+    let (mut repeats, mut merged) = (0u64, 0u64);
+    let (mut first_repeat, mut first_merged): (Option<EncoderRecord>, Option<EncoderRecord>) =
+        (None, None);
+    let mut group: Vec<EncoderRecord> = Vec::new();
+    let flush = |group: &mut Vec<EncoderRecord>, out: &mut Vec<EncoderRecord>| {
+        if let Some(first) = group.first().copied() {
+            let n = group.len() as f64;
+            let l = group.iter().map(|r| r.left as f64).sum::<f64>() / n;
+            let r = group.iter().map(|r| r.right as f64).sum::<f64>() / n;
+            out.push(EncoderRecord {
+                left: l.round() as i64,
+                right: r.round() as i64,
+                ..first
+            });
+        }
+        group.clear();
+    };
+    for rec in records.iter() {
+        match group.last() {
+            Some(last) if last.t == rec.t => {
+                if group
+                    .iter()
+                    .any(|g| g.left == rec.left && g.right == rec.right)
+                {
+                    repeats += 1;
+                    first_repeat.get_or_insert(*rec);
+                } else {
+                    merged += 1;
+                    first_merged.get_or_insert(*rec);
+                    group.push(*rec);
+                }
+            }
+            _ => {
+                flush(&mut group, &mut out);
+                group.push(*rec);
+            }
+        }
+    }
+    flush(&mut group, &mut out);
+    let mut findings = Vec::new();
+    if let Some(r) = first_repeat {
+        findings.push(Finding {
+            kind: FaultKind::Duplicate,
+            severity: Severity::Warning,
+            count: repeats,
+            first_line: Some(r.line),
+            time: Some(r.t),
+            message: format!(
+                "{repeats} ENCODER record(s) repeat an earlier one exactly (same timestamp \
+                 and counts, first at line {}); the repeats were dropped; check that the \
+                 logger writes each message once",
+                r.line
+            ),
+        });
+    }
+    if let Some(r) = first_merged {
+        let res = resolution(out.iter().map(|r| r.t));
+        findings.push(Finding {
+            kind: FaultKind::TimestampCollision,
+            severity: Severity::Warning,
+            count: merged,
+            first_line: Some(r.line),
+            time: Some(r.t),
+            message: format!(
+                "{merged} ENCODER record(s) share their timestamp with a different record \
+                 (first at line {}; the timestamps step by {res:.3} s at least, as if \
+                 rounded); the records of each timestamp were merged into one (their mean \
+                 count), which blurs the encoder timing; log timestamps to the microsecond",
+                r.line
+            ),
+        });
+    }
+    *records = out;
+    findings
+}
+
+/// Drops scans repeated exactly (same timestamp and ranges) and keeps only the first
+/// of different scans sharing a timestamp. `scans` is sorted by time.
+pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore) -> Vec<Finding> {
+    let mut out: Vec<ScanMeta> = Vec::with_capacity(scans.len());
+    let (mut repeats, mut collisions) = (0u64, 0u64);
+    let (mut first_repeat, mut first_collision): (Option<ScanMeta>, Option<ScanMeta>) =
+        (None, None);
+    for s in scans.iter() {
+        match out.last() {
+            Some(last) if last.t == s.t => {
+                if same_ranges(store, last, s) {
+                    repeats += 1;
+                    first_repeat.get_or_insert(*s);
+                } else {
+                    collisions += 1;
+                    first_collision.get_or_insert(*s);
+                }
+            }
+            _ => out.push(*s),
+        }
+    }
+    let mut findings = Vec::new();
+    if let Some(s) = first_repeat {
+        findings.push(Finding {
+            kind: FaultKind::Duplicate,
+            severity: Severity::Warning,
+            count: repeats,
+            first_line: Some(s.line),
+            time: Some(s.t),
+            message: format!(
+                "{repeats} scan(s) repeat an earlier one exactly (same timestamp and ranges, \
+                 first at line {}); the repeats were dropped (used twice they would make \
+                 the σ's too small); check that the logger writes each message once",
+                s.line
+            ),
+        });
+    }
+    if let Some(s) = first_collision {
+        findings.push(Finding {
+            kind: FaultKind::TimestampCollision,
+            severity: Severity::Warning,
+            count: collisions,
+            first_line: Some(s.line),
+            time: Some(s.t),
+            message: format!(
+                "{collisions} scan(s) share their timestamp with a different scan (first at \
+                 line {}); only the first scan of each timestamp was kept; log timestamps \
+                 to the microsecond",
+                s.line
+            ),
+        });
+    }
+    *scans = out;
+    findings
+}

@@ -1,0 +1,121 @@
+//! Wheel-slip episodes: samples where scan matching and odometry disagree in
+//! rotation. The sensor turns exactly as the robot does, so ŝθ = J21·Δφ_L + J22·Δφ_R
+//! whatever the laser pose; a robust straight-line fit of that relation flags the
+//! samples far from it, and consecutive flagged samples form an episode.
+
+use super::{since, FaultKind, Finding, Severity};
+use crate::run::Synchronized;
+use odocal_log::Log;
+
+/// A sample whose rotation residual exceeds this many robust σ is flagged.
+pub const FLAG_SIGMAS: f64 = 5.0;
+/// The robust σ is at least this (rad): below it, residuals are numerical noise.
+pub const SIGMA_FLOOR_RAD: f64 = 2e-4;
+/// Flagged samples above this share of all samples make the finding a warning.
+pub const WARN_SHARE: f64 = 0.05;
+
+/// Least squares of θ on (Δφ_L, Δφ_R) over the samples not excluded.
+fn fit(x: &[[f64; 2]], y: &[f64], out: &[bool]) -> Option<[f64; 2]> {
+    let (mut a, mut b, mut c, mut p, mut q) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for ((xi, yi), o) in x.iter().zip(y).zip(out) {
+        if *o {
+            continue;
+        }
+        a += xi[0] * xi[0];
+        b += xi[0] * xi[1];
+        c += xi[1] * xi[1];
+        p += xi[0] * yi;
+        q += xi[1] * yi;
+    }
+    let det = a * c - b * b;
+    (det.abs() > 1e-12 * (a * c).max(f64::MIN_POSITIVE))
+        .then(|| [(c * p - b * q) / det, (a * q - b * p) / det])
+}
+
+/// Indices of the samples flagged as slipping.
+pub fn flagged(synced: &Synchronized) -> Vec<usize> {
+    let x: Vec<[f64; 2]> = synced
+        .samples
+        .iter()
+        .map(|s| [s.wheel.dphi_l, s.wheel.dphi_r])
+        .collect();
+    let y: Vec<f64> = synced.samples.iter().map(|s| s.icp.pose.theta).collect();
+    let n = y.len();
+    if n < 20 {
+        return Vec::new();
+    }
+    let mut out = vec![false; n];
+    for _ in 0..4 {
+        let Some(j) = fit(&x, &y, &out) else {
+            return Vec::new();
+        };
+        let res: Vec<f64> = x
+            .iter()
+            .zip(&y)
+            .map(|(xi, yi)| yi - j[0] * xi[0] - j[1] * xi[1])
+            .collect();
+        let mut a: Vec<f64> = res.iter().map(|r| r.abs()).collect();
+        let mid = a.len() / 2;
+        let (_, med, _) = a.select_nth_unstable_by(mid, f64::total_cmp);
+        let sigma = (1.4826 * *med).max(SIGMA_FLOOR_RAD);
+        let next: Vec<bool> = res.iter().map(|r| r.abs() > FLAG_SIGMAS * sigma).collect();
+        if next == out {
+            break;
+        }
+        out = next;
+    }
+    (0..n).filter(|&k| out[k]).collect()
+}
+
+/// The slip episodes of the samples, with their times.
+pub fn episodes(log: &Log, synced: &Synchronized) -> Option<Finding> {
+    let flags = flagged(synced);
+    let first_k = *flags.first()?;
+    let s = &synced.samples;
+    // Consecutive samples (pairs chain: one's end is the next one's start) join.
+    let mut eps: Vec<(usize, usize)> = Vec::new();
+    for &k in &flags {
+        match eps.last_mut() {
+            Some(e) if s[k].pair.first <= s[e.1].pair.second => e.1 = k,
+            _ => eps.push((k, k)),
+        }
+    }
+    let t_start = log.scans.scans.first().map_or(0.0, |m| m.t);
+    let listed: Vec<String> = eps
+        .iter()
+        .take(8)
+        .map(|&(a, b)| {
+            format!(
+                "{:.1}–{:.1} s",
+                s[a].pair.t0 - t_start,
+                s[b].pair.t1 - t_start
+            )
+        })
+        .collect();
+    let more = if eps.len() > 8 { ", …" } else { "" };
+    let share = flags.len() as f64 / s.len() as f64;
+    let line = log.scans.scans.get(s[first_k].pair.first).map(|m| m.line);
+    Some(Finding {
+        kind: FaultKind::Slip,
+        severity: if share > WARN_SHARE {
+            Severity::Warning
+        } else {
+            Severity::Info
+        },
+        count: eps.len() as u64,
+        first_line: line,
+        time: Some(s[first_k].pair.t0),
+        message: format!(
+            "scan matching and odometry disagree in rotation in {} episode(s) ({} of {} \
+             samples, {:.1} %; wheel slip or bad scan matches) at {}{more} (times into the \
+             log, first {}); the outlier rejection leaves such samples out; if there are \
+             many, drive slower, with gentler accelerations, on a floor with more grip",
+            eps.len(),
+            flags.len(),
+            s.len(),
+            100.0 * share,
+            listed.join(", "),
+            since(s[first_k].pair.t0, t_start)
+        ),
+    })
+}

@@ -1,0 +1,29 @@
+//! The report of a calibration: the human summary and `results.json` ([`report`]),
+//! findings and checks other stages add to it ([`finding`]), where the run came from
+//! ([`provenance`]), the figures ([`figures`], drawn with `plotters`), the one-page
+//! `results.html` ([`html`]) and the files `--out DIR` writes ([`output`]).
+//!
+//! ```no_run
+//! use odocal_pipeline::{calibrate_log, NoProgress, Options};
+//! use odocal_report::build_report;
+//! # fn demo() -> Result<(), Box<dyn std::error::Error>> {
+//! let path = std::path::Path::new("robot.log");
+//! let log = odocal_log::read_log(path, &odocal_log::ReadOptions::default())?;
+//! let outcome = calibrate_log(&log, &Options::default(), &NoProgress)?;
+//! println!("{}", build_report(path, &log, &Options::default(), &outcome));
+//! # Ok(()) }
+//! ```
+
+#![deny(missing_docs)]
+
+pub mod figures;
+pub mod finding;
+pub mod html;
+pub mod output;
+pub mod provenance;
+pub mod report;
+
+pub use finding::{Finding, Severity};
+pub use output::{html_report, write_html, write_outputs};
+pub use provenance::{sha256_of_file, Provenance};
+pub use report::{build_report, Report};

@@ -1,0 +1,229 @@
+//! The report page, parsed with an HTML5 parser: every section and figure is there,
+//! nothing needs a script or the network, and every number on the page agrees with
+//! results.json (the page says where each comes from: `data-json`, `data-scale`,
+//! `data-digits` / `data-sig`). Runs the pipeline on the bundled demo log.
+
+use odocal_log::{read_log, ReadOptions};
+use odocal_pipeline::{calibrate_log, NoProgress, Options, Outcome};
+use odocal_report::figures::figures;
+use odocal_report::html::page_with_results;
+use odocal_report::{build_report, Finding, Provenance, Report, Severity};
+use scraper::{Html, Selector};
+use serde_json::{json, Value};
+use std::path::PathBuf;
+
+fn demo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../fixtures/demo.log")
+}
+
+/// The demo log calibrated with nominal values and the clock offset estimated.
+fn calibrated() -> (Options, Outcome, Report) {
+    let path = demo();
+    let log = read_log(&path, &ReadOptions::default()).expect("the demo log reads");
+    let opts = Options {
+        initial_params: Some(odocal_solver::Params::from_vector([
+            0.021, 0.021, 0.09, 0.0, 0.0, 0.0,
+        ])),
+        estimate_time_offset: Some(0.5),
+        ..Options::default()
+    };
+    let outcome = calibrate_log(&log, &opts, &NoProgress).expect("the demo log calibrates");
+    let report = build_report(&path, &log, &opts, &outcome);
+    (opts, outcome, report)
+}
+
+fn sel(s: &str) -> Selector {
+    Selector::parse(s).expect("a valid selector")
+}
+
+/// The sections every page has.
+const SECTIONS: [&str; 7] = [
+    "parameters",
+    "j-matrix",
+    "health",
+    "consistency",
+    "figures",
+    "data",
+    "run",
+];
+
+fn assert_sections(doc: &Html) {
+    for id in SECTIONS {
+        assert!(
+            doc.select(&sel(&format!("section#{id}"))).next().is_some(),
+            "section {id}"
+        );
+    }
+}
+
+/// Checks every number carrying `data-json` against `results`; returns the pointers.
+fn numbers_agree(doc: &Html, results: &Value) -> Vec<String> {
+    let mut pointers = Vec::new();
+    for el in doc.select(&sel("[data-json]")) {
+        let a = el.value();
+        let pointer = a.attr("data-json").unwrap().to_string();
+        let text: String = el.text().collect();
+        let expected = results
+            .pointer(&pointer)
+            .and_then(Value::as_f64)
+            .unwrap_or_else(|| panic!("{pointer} is not a number in results.json"));
+        let shown: f64 = text
+            .trim()
+            .parse()
+            .unwrap_or_else(|_| panic!("{pointer}: '{text}' is not a number"));
+        if let Some(digits) = a.attr("data-digits") {
+            let scale: f64 = a.attr("data-scale").unwrap().parse().unwrap();
+            let digits: i32 = digits.parse().unwrap();
+            let tol = 0.5 * 10f64.powi(-digits) * (1.0 + 1e-9) + 1e-12 * (expected * scale).abs();
+            assert!(
+                (shown - expected * scale).abs() <= tol,
+                "{pointer}: page shows {text}, results.json has {expected} (×{scale})"
+            );
+        } else {
+            let sig: i32 = a
+                .attr("data-sig")
+                .expect("data-digits or data-sig")
+                .parse()
+                .unwrap();
+            let tol = 0.5 * 10f64.powi(1 - sig) * expected.abs() * (1.0 + 1e-9);
+            assert!(
+                (shown - expected).abs() <= tol,
+                "{pointer}: page shows {text}, results.json has {expected}"
+            );
+        }
+        pointers.push(pointer);
+    }
+    pointers
+}
+
+#[test]
+fn page_has_every_section_and_figure_and_agrees_with_results_json() {
+    let (opts, outcome, mut report) = calibrated();
+    let t0 = outcome.synced.samples[0].pair.t0;
+    report.health.push(odocal_pipeline::Finding {
+        kind: odocal_pipeline::FaultKind::Slip,
+        severity: odocal_pipeline::Severity::Warning,
+        count: 1,
+        first_line: Some(1234),
+        time: Some(t0 + 10.0),
+        message: "rotation of scan matching and odometry disagree for 2.5 s".into(),
+    });
+    report.checks.push(Finding {
+        kind: "two_halves".into(),
+        severity: Severity::Info,
+        count: 6,
+        first_line: None,
+        time: None,
+        spans: vec![[t0 + 10.0, t0 + 12.5]],
+        message: "the two halves agree within 2σ".into(),
+    });
+    report.provenance = Some(Provenance {
+        command_line: "odocal calibrate fixtures/demo.log --report r.html".into(),
+        version: "0.1.0".into(),
+        input_sha256: "ab".repeat(32),
+        input_bytes: 42,
+        wall_time_s: 0.25,
+    });
+    // Fields of later features: held and prior parameters, an unknown result.
+    let mut results = serde_json::to_value(&report).unwrap();
+    results["settings"]["constraints"] = json!(["free", "free", {"held": 0.089}, "free", {"prior": {"mean": 0.0, "sigma": 0.002}}, "free"]);
+    results["later_feature"] = json!({"max_difference_sigma": 1.25, "halves": 2});
+
+    let figs = figures(&opts, &outcome, &report).expect("the figures draw");
+    let html = page_with_results(&report, &results, &figs);
+    let doc = Html::parse_document(&html);
+
+    assert_sections(&doc);
+    assert!(
+        doc.select(&sel("section#further")).next().is_some(),
+        "section further"
+    );
+    for name in [
+        "trajectory",
+        "residuals_time",
+        "residual_histograms",
+        "motion_coverage",
+        "time_offset",
+        "icp_quality",
+    ] {
+        let fig = doc
+            .select(&sel(&format!("figure#fig-{name}")))
+            .next()
+            .unwrap_or_else(|| panic!("figure {name}"));
+        assert!(
+            fig.select(&sel("svg")).next().is_some(),
+            "{name} has an inline SVG"
+        );
+        assert!(
+            fig.select(&sel("figcaption")).next().is_some(),
+            "{name} has a caption"
+        );
+    }
+    // Self-contained: no script, nothing loaded from elsewhere.
+    assert!(doc
+        .select(&sel("script, link, img, iframe"))
+        .next()
+        .is_none());
+    assert!(
+        !html.contains("http://")
+            || html.matches("http://").count()
+                == html.matches("xmlns=\"http://www.w3.org/2000/svg\"").count()
+    );
+    assert!(!html.contains("https://"));
+
+    let pointers = numbers_agree(&doc, &results);
+    for p in [
+        "/r_l",
+        "/r_r",
+        "/b",
+        "/l_x",
+        "/l_y",
+        "/l_theta",
+        "/sigma/0",
+        "/sigma/5",
+        "/j/1/1",
+        "/nominal/2",
+        "/correction_factors/0",
+        "/settings/constraints/2/held",
+        "/settings/constraints/4/prior/sigma",
+        "/later_feature/max_difference_sigma",
+        "/health/0/count",
+        "/checks/0/count",
+        "/provenance/wall_time_s",
+        "/samples_used",
+        "/time_offset_s",
+        "/covariance/5/5",
+    ] {
+        assert!(pointers.iter().any(|q| q == p), "{p} is not on the page");
+    }
+    let text: String = doc.root_element().text().collect();
+    assert!(text.contains("held at") && text.contains("prior") && text.contains("held (--fix)"));
+    assert!(text.contains("rotation of scan matching and odometry disagree"));
+    assert!(text.contains(&"ab".repeat(32)));
+    // A finding's span is shaded in the residuals over time, and named in the legend.
+    assert!(text.contains("flagged span (slip)"));
+}
+
+#[test]
+fn page_without_optional_results_still_has_every_section() {
+    let path = demo();
+    let log = read_log(&path, &ReadOptions::default()).unwrap();
+    let opts = Options::default();
+    let outcome = calibrate_log(&log, &opts, &NoProgress).unwrap();
+    let report = build_report(&path, &log, &opts, &outcome);
+    let html = odocal_report::html_report(&opts, &outcome, &report).unwrap();
+    let doc = Html::parse_document(&html);
+    assert_sections(&doc);
+    assert!(
+        doc.select(&sel("section#further")).next().is_none(),
+        "nothing unknown to show"
+    );
+    assert!(
+        doc.select(&sel("figure#fig-time_offset")).next().is_none(),
+        "no offset estimated"
+    );
+    let text: String = doc.root_element().text().collect();
+    // Every run compares the two halves of its log: that check is always listed.
+    assert!(text.contains("No data-health findings") && text.contains("two halves of the log"));
+    numbers_agree(&doc, &serde_json::to_value(&report).unwrap());
+}
