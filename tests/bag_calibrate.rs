@@ -111,6 +111,11 @@ fn db3_with_velocity_only_joint_states_calibrates() {
 }
 
 #[test]
+fn turtlebot_lds_360_degree_sweeping_laser_calibrates() {
+    check("turtlebot_lds.bag");
+}
+
+#[test]
 fn ros2_bag_directory_calibrates() {
     check("khepera_ros2_dir");
 }

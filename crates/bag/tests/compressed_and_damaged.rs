@@ -46,13 +46,18 @@ fn zstd_and_lz4_chunks_read_the_same_as_uncompressed() {
         let copy = read_bag(&path, &BagOptions::default()).unwrap();
         assert_eq!(copy.log.scans, original.log.scans, "{name}");
         assert_eq!(copy.log.encoders, original.log.encoders, "{name}");
-        assert!(copy.bytes_read < original.bytes_read, "{name} is compressed");
+        assert!(
+            copy.bytes_read < original.bytes_read,
+            "{name} is compressed"
+        );
         // A flipped byte inside a compressed chunk fails its CRC or its decompression.
         let mut bytes = std::fs::read(&path).unwrap();
         let n = bytes.len();
         bytes[n / 2] ^= 0x5a;
         std::fs::write(&path, &bytes).unwrap();
-        let e = read_bag(&path, &BagOptions::default()).unwrap_err().to_string();
+        let e = read_bag(&path, &BagOptions::default())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains(&path.display().to_string()), "{e}");
         let _ = std::fs::remove_file(path);
     }
