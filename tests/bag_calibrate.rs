@@ -116,6 +116,11 @@ fn turtlebot_lds_360_degree_sweeping_laser_calibrates() {
 }
 
 #[test]
+fn pioneer_sick_181_rays_clockwise_ros1_bz2_calibrates() {
+    check("pioneer_sick_bz2.bag");
+}
+
+#[test]
 fn ros2_bag_directory_calibrates() {
     check("khepera_ros2_dir");
 }
