@@ -118,8 +118,9 @@ fn json_output_and_out_dir() {
     );
     assert!(p["command_line"].as_str().unwrap().contains("--plots"));
 
-    // Human summary, and the report page on its own.
-    let page = out_dir.join("page.html");
+    // Human summary, and the report page on its own, into a directory that does not
+    // exist yet (created, as for --out).
+    let page = out_dir.join("pages").join("page.html");
     let o = odocal(&[
         "calibrate",
         log,

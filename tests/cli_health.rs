@@ -163,3 +163,46 @@ fn an_offset_beyond_the_search_range_names_the_wider_range() {
         .all(|f| f["kind"] != "clock_offset"));
     cleanup(&path);
 }
+
+#[test]
+fn terminal_escapes_in_a_log_are_never_echoed_raw() {
+    let dir = common::temp_dir("cli-health-escape");
+    let path = dir.join("esc.log");
+    std::fs::write(
+        &path,
+        "\x1b]0;pwned\x07FAKE 1 2\nENCODER 1 \x1b[2J 3.0 h 3.0\n",
+    )
+    .unwrap();
+    let o = odocal(&["info", path.to_str().unwrap(), "--lenient"]);
+    let out = text(&o.stdout) + &text(&o.stderr);
+    assert!(o.status.success(), "{out}");
+    assert!(!out.contains('\x1b') && !out.contains('\x07'), "{out:?}");
+    assert!(out.contains("\\x1b]0;pwned\\x07FAKE"), "{out}");
+    let o = odocal(&["info", path.to_str().unwrap()]);
+    let err = text(&o.stderr);
+    assert!(!o.status.success() && !err.contains('\x1b'), "{err:?}");
+    assert!(err.contains("\\x1b[2J"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn info_names_the_faults_it_can_see_without_matching() {
+    let (path, _) = simulated_log("cli-health-info", "khepera", 20.0, 64, |_| {});
+    let text_log = std::fs::read_to_string(&path).unwrap();
+    let doubled: String = text_log
+        .lines()
+        .flat_map(|l| {
+            let n = if l.starts_with("ENCODER") { 2 } else { 1 };
+            std::iter::repeat_n(format!("{l}\n"), n)
+        })
+        .collect();
+    std::fs::write(&path, doubled).unwrap();
+    let o = odocal(&["info", path.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let h = v["health"].as_array().expect("a health list");
+    assert_eq!(h.len(), 1, "{h:?}");
+    assert_eq!(h[0]["kind"], "duplicate");
+    assert_eq!(h[0]["count"], 1000);
+    cleanup(&path);
+}

@@ -4,6 +4,7 @@ use crate::input::InputArgs;
 use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
+use odocal_log::{encoders_from_odometry, NominalWheels, ValueSource, WHEEL_TICKS_PER_REVOLUTION};
 use odocal_pipeline::{calibrate_log, Options, Trim};
 use odocal_report::{build_report, sha256_of_file, write_html, write_outputs, Provenance};
 use odocal_solver::Params;
@@ -120,16 +121,50 @@ fn nominal_params(v: &[f64]) -> anyhow::Result<Params> {
     Ok(Params::from_vector(full))
 }
 
+/// Odometry-only mode: a log (or bag) with odometry poses but no wheel encoders. The
+/// poses were integrated with nominal parameters; each interval's wheel rotations are
+/// recovered from the pose increments with them (`--nominal`, required here) and become
+/// the log's encoder records. Returns the nominal wheels when the mode applies.
+fn odometry_only_mode(
+    file: &std::path::Path,
+    log: &mut odocal_log::Log,
+    nominal: Option<&Params>,
+) -> anyhow::Result<Option<NominalWheels>> {
+    if !log.encoders.is_empty() || log.odom.is_empty() {
+        return Ok(None);
+    }
+    let Some(p) = nominal else {
+        anyhow::bail!(
+            "{}: odometry-only mode (odometry poses, no wheel encoders): the wheel rotations \
+             are recovered from the poses with the parameters the robot integrated them \
+             with; give them with --nominal r_L,r_R,b (metres)",
+            file.display()
+        );
+    };
+    let wheels = NominalWheels {
+        r_l: p.r_l,
+        r_r: p.r_r,
+        b: p.b,
+    };
+    let Some(encoders) = encoders_from_odometry(&log.odom, wheels) else {
+        anyhow::bail!("{}: an odometry pose is not finite", file.display());
+    };
+    log.encoders = encoders;
+    log.params.ticks_per_revolution = Some((WHEEL_TICKS_PER_REVOLUTION, ValueSource::Convention));
+    Ok(Some(wheels))
+}
+
 /// Runs `odocal calibrate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let input = &args.input;
     let pool = input.thread_pool()?;
     let t_parse = Instant::now();
-    let log = input.read_log()?;
+    let mut log = input.read_log()?;
     let parse_s = t_parse.elapsed().as_secs_f64();
 
     let initial_params = args.nominal.as_deref().map(nominal_params).transpose()?;
+    let odometry_only = odometry_only_mode(&input.read.log, &mut log, initial_params.as_ref())?;
     let mut opts = Options {
         initial_params,
         ticks_per_revolution: input.read.ticks_per_rev,
@@ -172,9 +207,36 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .with_context(|| format!("cannot write the results into {}", dir.display()))
     });
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        let mut value = serde_json::to_value(&report)?;
+        if let (Some(nominal), Some(obj)) = (&odometry_only, value.as_object_mut()) {
+            obj.insert(
+                "odometry_only".into(),
+                serde_json::json!({
+                    "nominal": {"r_l": nominal.r_l, "r_r": nominal.r_r, "b": nominal.b},
+                    "correction_factors": {
+                        "r_l": report.r_l / nominal.r_l,
+                        "r_r": report.r_r / nominal.r_r,
+                        "b": report.b / nominal.b,
+                    },
+                }),
+            );
+        }
+        println!("{}", serde_json::to_string_pretty(&value)?);
     } else {
         print!("{report}");
+        if let Some(n) = &odometry_only {
+            println!(
+                "odometry-only mode: wheel rotations recovered from the odometry poses with the \
+                 nominal r_L = {} m, r_R = {} m, b = {} m\ncorrection factors of the nominal: \
+                 r_L x{:.5}, r_R x{:.5}, b x{:.5}",
+                n.r_l,
+                n.r_r,
+                n.b,
+                report.r_l / n.r_l,
+                report.r_r / n.r_r,
+                report.b / n.b
+            );
+        }
     }
     match (written, &args.out) {
         (Some(Err(e)), _) => return Err(e.context("the results above were printed only")),

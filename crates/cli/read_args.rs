@@ -1,15 +1,35 @@
 //! The arguments of every command that reads a log: the file and how to read it.
 //! `calibrate`, `match` and `info` flatten this one struct, so each reading option
-//! exists on every such command.
+//! exists on every such command. The input is a Carmen/JSON log or a ROS bag (ROS 1
+//! `.bag`, ROS 2 directory, `.mcap`, `.db3`), told apart by content.
 
+use anyhow::Context;
+use odocal_bag::{detect_bag, read_bag, BagOptions, Clock, TopicChoice};
 use odocal_log::{read_log, Log, Mode, ReadOptions};
 use std::path::PathBuf;
 
 /// The input log and the options of reading it.
 #[derive(clap::Args, Debug)]
 pub struct ReadArgs {
-    /// The log (Carmen-style text with ENCODER lines, or the original package's JSON log).
+    /// The log: Carmen-style text, the original package's JSON log, or a ROS bag (ROS 1
+    /// .bag, ROS 2 bag directory, .mcap or .db3).
     pub log: PathBuf,
+    /// Bag: the sensor_msgs/LaserScan topic (default: the only one).
+    #[arg(long, value_name = "TOPIC")]
+    pub scan_topic: Option<String>,
+    /// Bag: the sensor_msgs/JointState topic with the wheel joints (default: the only one).
+    #[arg(long, value_name = "TOPIC")]
+    pub joint_states_topic: Option<String>,
+    /// Bag: the nav_msgs/Odometry topic; selects the odometry-only mode (needs --nominal).
+    #[arg(long, value_name = "TOPIC")]
+    pub odom_topic: Option<String>,
+    /// Bag: the left and right wheel joint names (default: the only joints named like a
+    /// left and a right wheel).
+    #[arg(long, value_name = "LEFT,RIGHT", value_delimiter = ',', num_args = 2)]
+    pub wheel_joints: Option<Vec<String>>,
+    /// Bag: stamp messages with the bag's record time instead of their header stamp.
+    #[arg(long)]
+    pub use_receive_time: bool,
     /// Encoder ticks per wheel revolution (overrides the log's PARAM).
     #[arg(long, value_name = "X")]
     pub ticks_per_rev: Option<f64>,
@@ -44,8 +64,65 @@ impl ReadArgs {
         }
     }
 
-    /// Reads the log, strict unless `--lenient`, with the command-line overrides.
+    /// The bag reading options these arguments ask for.
+    pub fn bag_options(&self) -> BagOptions {
+        BagOptions {
+            choice: TopicChoice {
+                scan_topic: self.scan_topic.clone(),
+                joint_states_topic: self.joint_states_topic.clone(),
+                odom_topic: self.odom_topic.clone(),
+                wheel_joints: self
+                    .wheel_joints
+                    .as_ref()
+                    .filter(|v| v.len() == 2)
+                    .map(|v| (v[0].clone(), v[1].clone())),
+            },
+            clock: if self.use_receive_time {
+                Clock::Receive
+            } else {
+                Clock::Header
+            },
+            read: self.read_options(),
+        }
+    }
+
+    /// True when the input is a ROS bag (by content).
+    pub fn is_bag(&self) -> anyhow::Result<bool> {
+        Ok(detect_bag(&self.log)
+            .with_context(|| format!("cannot open {}", self.log.display()))?
+            .is_some())
+    }
+
+    /// Reads the log or bag, strict unless `--lenient`, with the command-line overrides.
+    /// For a bag, what was chosen and why goes to stderr.
     pub fn read_log(&self) -> anyhow::Result<Log> {
+        if self.is_bag()? {
+            if self.ticks_per_rev.is_some() || self.encoder_modulus.is_some() {
+                anyhow::bail!(
+                    "{}: --ticks-per-rev and --encoder-modulus apply to Carmen logs; a bag's \
+                     wheel joints are read in radians",
+                    self.log.display()
+                );
+            }
+            let bag =
+                read_bag(&self.log, &self.bag_options()).map_err(|e| anyhow::anyhow!("{e}"))?;
+            for r in &bag.selection.reasons {
+                eprintln!("{r}");
+            }
+            return Ok(bag.log);
+        }
+        let bag_flags = self.scan_topic.is_some()
+            || self.joint_states_topic.is_some()
+            || self.odom_topic.is_some()
+            || self.wheel_joints.is_some()
+            || self.use_receive_time;
+        if bag_flags {
+            anyhow::bail!(
+                "{}: --scan-topic, --joint-states-topic, --odom-topic, --wheel-joints and \
+                 --use-receive-time apply to ROS bags; this file is not one",
+                self.log.display()
+            );
+        }
         // The reader's message already says everything (file, line, cause).
         read_log(&self.log, &self.read_options()).map_err(|e| anyhow::anyhow!("{e}"))
     }

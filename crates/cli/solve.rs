@@ -60,6 +60,7 @@ pub struct Args {
 pub fn sample_from_record(rec: &TupleRecord) -> Sample {
     let mut s = Sample::from_speeds(rec.t, rec.phi_l, rec.phi_r, Pose2::from_array(rec.sm));
     s.sm_cov = rec.sm_cov;
+    s.scan_times = rec.t0.zip(rec.t1).map(|(t0, t1)| [t0, t1]);
     s.profile = rec.profile.as_ref().map(|pieces| {
         pieces
             .iter()

@@ -26,6 +26,7 @@ mod read;
 mod summary;
 mod tokens;
 mod tuple;
+mod wheel_angles;
 mod writer;
 
 pub use carmen::read_carmen_from;
@@ -39,4 +40,8 @@ pub use read::{detect_format, read_log, LogFormat};
 pub use summary::{GeometrySummary, LogSummary, SkippedLine};
 pub use tokens::MAX_COUNT;
 pub use tuple::{read_tuples, read_tuples_from, write_tuple, TupleRecord};
+pub use wheel_angles::{
+    encoders_from_odometry, ticks_of_angle, wheel_rotations, NominalWheels,
+    WHEEL_TICKS_PER_REVOLUTION,
+};
 pub use writer::{write_log, LogWriter, RobotLaserPoses};

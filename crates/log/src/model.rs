@@ -16,6 +16,9 @@ pub enum ValueSource {
     CommandLine,
     /// The format's default.
     Default,
+    /// Fixed by the reader's convention: wheel angles read in radians (ROS joint states,
+    /// odometry) are counted in [`crate::WHEEL_TICKS_PER_REVOLUTION`] ticks per turn.
+    Convention,
 }
 
 /// Configuration gathered from `PARAM` lines (later lines override earlier ones).
@@ -93,6 +96,8 @@ pub enum ScanKind {
     FLaser,
     /// The original package's JSON log.
     Json,
+    /// A `sensor_msgs/LaserScan` message of a ROS bag.
+    LaserScan,
 }
 
 /// The geometry shared by scans from one sensor configuration.

@@ -200,6 +200,7 @@ impl fmt::Display for ValueSource {
             ValueSource::LogParam { line } => write!(f, "PARAM on line {line}"),
             ValueSource::CommandLine => write!(f, "command line"),
             ValueSource::Default => write!(f, "default"),
+            ValueSource::Convention => write!(f, "wheel angles in radians, fixed scale"),
         }
     }
 }

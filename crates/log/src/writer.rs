@@ -312,7 +312,7 @@ pub fn write_log<W: Write>(w: W, log: &Log) -> io::Result<()> {
             Some((1, _)) => {
                 if let Some(s) = log.scans.get(is) {
                     match s.kind {
-                        ScanKind::RawLaser1 | ScanKind::Json => {
+                        ScanKind::RawLaser1 | ScanKind::Json | ScanKind::LaserScan => {
                             out.rawlaser1_with_remissions(s.t, s.geometry, s.ranges, s.remissions)?
                         }
                         ScanKind::RobotLaser1 => out.robotlaser1_with_remissions(

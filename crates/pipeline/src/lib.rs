@@ -23,6 +23,7 @@
 #![deny(missing_docs)]
 
 pub mod atomic_file;
+pub mod consistency;
 mod error;
 pub mod estimate;
 pub mod health;

@@ -1,5 +1,6 @@
 //! The whole pipeline: synchronize, match, (estimate the clock offset,) solve.
 
+use crate::consistency::{check_halves, Consistency};
 use crate::error::PipelineError;
 use crate::health::{self, FaultKind, Finding, Severity};
 use crate::matching::{match_pairs, MatchStats};
@@ -142,6 +143,8 @@ pub struct Outcome {
     pub offset: Option<OffsetEstimate>,
     /// Wall time per stage.
     pub timing: Timing,
+    /// The two halves of the samples calibrated separately and compared.
+    pub consistency: Consistency,
 }
 
 /// Ticks per revolution from the options or the log, checking the log has what
@@ -523,12 +526,22 @@ pub fn calibrate_log(
         timing.solve += t.elapsed().as_secs_f64();
     }
 
+    let t = Instant::now();
+    let samples: Vec<_> = synced
+        .samples
+        .iter()
+        .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
+        .collect();
+    let consistency = check_halves(&samples, &opts.solve_options());
+    timing.solve += t.elapsed().as_secs_f64();
+
     Ok(Outcome {
         health: findings,
         synced,
         calibration,
         offset,
         timing,
+        consistency,
     })
 }
 

@@ -30,6 +30,7 @@ impl PairSample {
             dphi_r: self.wheel.dphi_r,
             sm: self.icp.pose,
             sm_cov: use_icp_covariance.then_some(self.icp.covariance),
+            scan_times: Some([self.pair.t0, self.pair.t1]),
             profile: use_profile.then(|| {
                 self.wheel
                     .profile
@@ -87,6 +88,7 @@ pub fn wheel_only_sample(w: &WheelMotion) -> Sample {
         dphi_r: w.dphi_r,
         sm: odocal_geom::Pose2::IDENTITY,
         sm_cov: None,
+        scan_times: None,
         profile: Some(
             w.profile
                 .iter()

@@ -230,33 +230,36 @@ mod tests {
             accuracy: 0.0,
             remission_mode: 0,
         };
-        let dt = 0.2 / 180.0;
-        let geometry = ScanGeometry::new(fields, n).with_timing(dt, 0.0);
-        // Ray i is fired at t0 + i·dt, the robot turned by ω (i·dt − 0.1) from its
-        // heading at the reference time.
-        let t0 = 0.5;
-        let ranges: Vec<f32> = (0..n)
-            .map(|i| {
-                let turn = omega * (i as f64 * dt - 0.1);
-                let a = geometry.angles[i] + turn;
-                ((2.0 - 0.1 * turn.cos()) / a.cos()) as f32
-            })
-            .collect();
         let wall_error = |r: &[f32], a: &[f64]| {
             (0..n)
                 .map(|i| (0.1 + r[i] as f64 * a[i].cos() - 2.0).abs())
                 .fold(0.0, f64::max)
         };
-        let mut store = ScanStore::default();
-        store.push(t0, &geometry, &ranges, ScanKind::RawLaser1, 0);
-        let scan = store.get(0).unwrap();
-        assert!((reference_time(&scan) - 0.6).abs() < 1e-12);
-        let (r, a) = compensate_scan(&scan, &track, &limits, &params, 0.0).unwrap();
-        // Encoder ticks are whole (1e-5 rev): some 1e-5 m of error remain.
-        let compensated = wall_error(&r, &a);
-        assert!(compensated < 2e-4, "compensated: {compensated}");
-        let raw = wall_error(&ranges, &geometry.angles);
-        assert!(raw > 0.1, "as logged: {raw}");
+        // Ray 0 first (t0 = 0.5), or, with a negative increment (a driver stamping
+        // the last ray), ray 0 last (t0 = 0.7): the reference time is 0.6 either way,
+        // and ray i is fired with the robot turned by ω (t0 + i·dt − 0.6).
+        for (dt, t0) in [(0.2 / 180.0, 0.5), (-0.2 / 180.0, 0.7)] {
+            let geometry = ScanGeometry::new(fields, n).with_timing(dt, 0.0);
+            let ranges: Vec<f32> = (0..n)
+                .map(|i| {
+                    let turn = omega * (t0 + i as f64 * dt - 0.6);
+                    let a = geometry.angles[i] + turn;
+                    ((2.0 - 0.1 * turn.cos()) / a.cos()) as f32
+                })
+                .collect();
+            let mut store = ScanStore::default();
+            store.push(t0, &geometry, &ranges, ScanKind::RawLaser1, 0);
+            let scan = store.get(0).unwrap();
+            assert!((reference_time(&scan) - 0.6).abs() < 1e-12);
+            let (r, a) = compensate_scan(&scan, &track, &limits, &params, 0.0).unwrap();
+            // Encoder ticks are whole (1e-5 rev): some 1e-5 m of error remain.
+            let compensated = wall_error(&r, &a);
+            assert!(compensated < 2e-4, "dt {dt}: compensated {compensated}");
+            let raw = wall_error(&ranges, &geometry.angles);
+            assert!(raw > 0.1, "dt {dt}: as logged {raw}");
+        }
+        let geometry = ScanGeometry::new(fields, n).with_timing(0.2 / 180.0, 0.0);
+        let ranges = vec![2.0f32; n];
         // Outside the encoder stream: not compensated.
         let mut late = ScanStore::default();
         late.push(5.0, &geometry, &ranges, ScanKind::RawLaser1, 0);

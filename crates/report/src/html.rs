@@ -34,7 +34,7 @@ const SHOWN: [&str; 14] = [
 ];
 
 /// Keys of the "Data and solution" section, in order.
-const DATA_KEYS: [&str; 18] = [
+const DATA_KEYS: [&str; 20] = [
     "log_contents",
     "samples_used",
     "samples_synchronized",
@@ -49,6 +49,8 @@ const DATA_KEYS: [&str; 18] = [
     "cost_before",
     "cost_after",
     "observability",
+    "shared_scan_noise",
+    "consistency",
     "covariance",
     "closed_form",
     "settings",

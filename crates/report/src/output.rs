@@ -20,13 +20,17 @@ pub fn html_report(opts: &Options, outcome: &Outcome, report: &Report) -> io::Re
     Ok(page(report, &drawn(opts, outcome, report)?))
 }
 
-/// Writes the report page to `path`.
+/// Writes the report page to `path`, creating its directory when missing (as
+/// `--out DIR` does).
 pub fn write_html(
     path: &Path,
     opts: &Options,
     outcome: &Outcome,
     report: &Report,
 ) -> io::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        fs::create_dir_all(dir)?;
+    }
     write_bytes_atomically(path, html_report(opts, outcome, report)?.as_bytes())
 }
 

@@ -1,12 +1,13 @@
 //! The report of a calibration: what `--json` prints and `results.json` holds, and
 //! the human summary.
 
-use crate::finding::Finding;
+use crate::finding::{Finding, Severity};
 use crate::provenance::Provenance;
 use odocal_log::Log;
+use odocal_pipeline::consistency::Consistency;
 use odocal_pipeline::sync::DiscardCounts;
 use odocal_pipeline::{Estimate, Options, Outcome, Timing};
-use odocal_solver::{Constraint, Observability, PARAMETER_NAMES};
+use odocal_solver::{Constraint, Observability, SharedScanNoise, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
 use std::path::Path;
@@ -64,6 +65,11 @@ pub struct Report {
     pub cost_after: f64,
     /// Observability verdicts.
     pub observability: Observability,
+    /// The two halves of the samples calibrated separately and compared.
+    pub consistency: Consistency,
+    /// The noise shared by consecutive samples (through their common scan) that the
+    /// covariance accounts for; absent when the samples were treated as independent.
+    pub shared_scan_noise: Option<SharedScanNoise>,
     /// Estimated clock offset (s, laser clock minus encoder clock), when asked.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_s: Option<f64>,
@@ -130,6 +136,28 @@ pub struct Settings {
     pub accept_weak: bool,
 }
 
+/// The two-halves check as a finding: a note when the halves agree or could not
+/// be checked, a warning when they disagree beyond 3σ.
+fn two_halves(c: &Consistency) -> Finding {
+    let (severity, message) = match c {
+        Consistency::Checked(h) if h.agree => (Severity::Info, h.sentence.clone()),
+        Consistency::Checked(h) => (Severity::Warning, h.sentence.clone()),
+        Consistency::NotAvailable { reason } => (
+            Severity::Info,
+            format!("the two halves of the log were not compared: {reason}"),
+        ),
+    };
+    Finding {
+        kind: "two_halves".into(),
+        severity,
+        count: 1,
+        first_line: None,
+        time: None,
+        spans: Vec::new(),
+        message,
+    }
+}
+
 /// Builds the report of a finished calibration.
 pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -> Report {
     let c = &outcome.calibration;
@@ -167,12 +195,14 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         cost_before: c.cost_before,
         cost_after: c.cost_after,
         observability: c.observability.clone(),
+        consistency: outcome.consistency.clone(),
+        shared_scan_noise: c.shared_scan_noise,
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
         nominal: opts.initial_params.map(|p| p.to_vector()),
         correction_factors: opts
             .initial_params
             .map(|n| [v[0] / n.r_l, v[1] / n.r_r, v[2] / n.b]),
-        checks: Vec::new(),
+        checks: vec![two_halves(&outcome.consistency)],
         provenance: None,
         sweep_compensated_s: outcome.synced.sweep_compensated.then(|| {
             log.scans
@@ -298,6 +328,17 @@ impl fmt::Display for Report {
             self.sm_sigma[1] * 1e3,
             self.sm_sigma[2].to_degrees()
         )?;
+        if let Some(n) = &self.shared_scan_noise {
+            writeln!(
+                f,
+                "  shared by consecutive samples through their common scan: {:.0} %, {:.0} %, {:.0} % \
+                 of it (x, y, θ; {} shared scans), accounted for in the σ above",
+                100.0 * n.shared_fraction[0],
+                100.0 * n.shared_fraction[1],
+                100.0 * n.shared_fraction[2],
+                n.shared_scans
+            )?;
+        }
         writeln!(
             f,
             "  cost: {:.4e} (closed form) → {:.4e}",

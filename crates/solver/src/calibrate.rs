@@ -1,7 +1,7 @@
 //! The whole chain: checks, closed form (step 1 + step 2) with outlier trimming,
 //! noise estimate, maximum-likelihood refinement, covariance, observability.
 
-use crate::constraints::Constraints;
+use crate::constraints::{Constraint, Constraints};
 use crate::covariance::{invert_information, Inversion};
 use crate::error::SolveError;
 use crate::kinematics::{residual_of, Predictor, RawOdometry};
@@ -15,9 +15,11 @@ use crate::params::Params;
 use crate::partial::{step1_held, step2_held};
 use crate::refine::{constrained_normal_equations, refine, Refinement};
 use crate::sample::Sample;
+use crate::shared_scans::{score_covariance, SharedScanNoise};
 use crate::step1::{step1, Step1};
 use crate::step2::{build_m, solve_m, Step2, A_SINGULAR_CONDITION};
 use crate::trimming::Trim;
+use nalgebra::SMatrix;
 use serde::{Deserialize, Serialize};
 
 /// Fewest samples the solver accepts (input and after each trimming round).
@@ -135,6 +137,10 @@ pub struct Calibration {
     pub refinement: Option<Refinement>,
     /// Observability report.
     pub observability: Observability,
+    /// The noise shared by samples that share a scan, when the samples carry their
+    /// scans' times (the covariance then accounts for it); `None`: the samples
+    /// were treated as independent.
+    pub shared_scan_noise: Option<SharedScanNoise>,
 }
 
 /// Closed form (step 1 and step 2) on all `samples`, without trimming: the
@@ -249,6 +255,26 @@ fn closed_form_held(
         step1: Step1 { j21, j22, ..s1 },
         step2: s2,
     })
+}
+
+/// `H⁻¹ (M + P) H⁻¹`: the covariance of the estimate when the score `Σ GᵀWe` has
+/// covariance `M` (not `H`: samples sharing scans) and the priors add their
+/// information `P`. `inverse` is `H⁻¹` with held rows zero.
+fn sandwich(
+    inverse: &[[f64; 6]; 6],
+    score: &[[f64; 6]; 6],
+    constraints: &Constraints,
+) -> [[f64; 6]; 6] {
+    let mut meat = *score;
+    for (i, c) in constraints.0.iter().enumerate() {
+        if let Constraint::Prior { sigma, .. } = c {
+            meat[i][i] += 1.0 / (sigma * sigma);
+        }
+    }
+    let hi = SMatrix::<f64, 6, 6>::from_fn(|i, j| inverse[i][j]);
+    let m = SMatrix::<f64, 6, 6>::from_fn(|i, j| meat[i][j]);
+    let c = hi * m * hi;
+    std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (c[(i, j)] + c[(j, i)])))
 }
 
 /// The covariance with the rows and columns of held parameters set to zero.
@@ -383,8 +409,14 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // Motion classes with the estimated radii; for the "not excited" errors, where
     // the estimate is not trustworthy, with equal radii.
     let motion_equal_radii = || MotionContent::classify(&active, 1.0, 1.0);
-    let covariance = match invert_information(&information) {
-        Inversion::Covariance(c) => zero_held_rows(*c, &constraints),
+    let (covariance, shared_scan_noise) = match invert_information(&information) {
+        Inversion::Covariance(c) => {
+            let inverse = zero_held_rows(*c, &constraints);
+            match score_covariance(&active, &params, &weights) {
+                Some((score, model)) => (sandwich(&inverse, &score, &constraints), Some(model)),
+                None => (inverse, None),
+            }
+        }
         Inversion::Singular(null) => {
             return Err(information_not_excited(
                 null_direction_names(&null),
@@ -430,5 +462,6 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         reduced_chi2: cost_after / (3 * active.len()).saturating_sub(6).max(1) as f64,
         refinement,
         observability,
+        shared_scan_noise,
     })
 }

@@ -56,6 +56,7 @@ mod params;
 mod partial;
 pub mod refine;
 mod sample;
+mod shared_scans;
 pub mod step1;
 pub mod step2;
 pub mod trimming;
@@ -78,4 +79,5 @@ pub use observability::{
 pub use params::{Params, PARAMETER_NAMES};
 pub use refine::Refinement;
 pub use sample::{ProfileSegment, Sample};
+pub use shared_scans::{SharedScanNoise, MIN_SHARED_SCANS};
 pub use trimming::Trim;

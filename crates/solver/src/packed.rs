@@ -18,6 +18,8 @@ pub(crate) struct Packed<'a> {
     pub index: usize,
     /// The wheel-speed profile, when present and used.
     pub profile: Option<&'a [ProfileSegment]>,
+    /// Timestamps of the two scans, when known.
+    pub scan_times: Option<[f64; 2]>,
 }
 
 impl<'a> Packed<'a> {
@@ -28,6 +30,7 @@ impl<'a> Packed<'a> {
             dphi_r: sample.dphi_r,
             sm: sample.sm.to_array(),
             index,
+            scan_times: sample.scan_times,
             profile: if use_profile {
                 sample.profile.as_deref()
             } else {

@@ -32,6 +32,12 @@ pub struct Sample {
     /// Wheel rotations piece by piece inside the interval, when the speeds were not
     /// constant. Its rotations must add up to `dphi_l`, `dphi_r`.
     pub profile: Option<Vec<ProfileSegment>>,
+    /// Timestamps of the interval's two scans (s, any clock), when known. Samples
+    /// that share a scan (one ends where the next starts) share that scan's
+    /// matching error and its encoder reading: with these times the covariance of
+    /// the estimate accounts for it (see [`crate::calibrate`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scan_times: Option<[f64; 2]>,
 }
 
 /// Relative tolerance for a profile's rotations to add up to the sample's totals.
@@ -47,6 +53,7 @@ impl Sample {
             sm,
             sm_cov: None,
             profile: None,
+            scan_times: None,
         }
     }
 
@@ -68,12 +75,19 @@ impl Sample {
             sm,
             sm_cov: None,
             profile: Some(profile),
+            scan_times: None,
         }
     }
 
     /// The same sample with the covariance of `ŝ` attached.
     pub fn with_covariance(mut self, cov: [[f64; 3]; 3]) -> Self {
         self.sm_cov = Some(cov);
+        self
+    }
+
+    /// The same sample with the timestamps of its two scans attached.
+    pub fn with_scan_times(mut self, t0: f64, t1: f64) -> Self {
+        self.scan_times = Some([t0, t1]);
         self
     }
 

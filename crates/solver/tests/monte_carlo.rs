@@ -15,12 +15,7 @@ use rand::Rng;
 use rand_distr::{Distribution, Normal};
 
 fn truth() -> Params {
-    Params {
-        r_l: 0.0305,
-        r_r: 0.0298,
-        b: 0.32,
-        laser: Pose2::new(0.08, -0.03, 0.6),
-    }
+    common::test_robot()
 }
 
 fn nees(cal: &Calibration, truth: &Params) -> f64 {

@@ -67,6 +67,16 @@ pub fn read_reference_results(path: &std::path::Path) -> (Params, [[f64; 6]; 6])
     (params, cov)
 }
 
+/// The robot of the synthetic tests: unequal radii, a displaced and turned sensor.
+pub fn test_robot() -> Params {
+    Params {
+        r_l: 0.0305,
+        r_r: 0.0298,
+        b: 0.32,
+        laser: Pose2::new(0.08, -0.03, 0.6),
+    }
+}
+
 /// A seeded random generator.
 pub fn rng(seed: u64) -> StdRng {
     StdRng::seed_from_u64(seed)

@@ -1,0 +1,284 @@
+//! What one pass over a bag gathers: every topic with its type, count and time span,
+//! and the decoded messages of the topics that may be used (laser scans, joint states,
+//! odometry). Other topics are counted from their record headers and never decoded.
+
+use crate::error::BagError;
+use crate::messages::{
+    decode_joint_state, decode_laser_scan, decode_odometry, MessageKind, OdometryMsg, ScanFields,
+};
+use crate::wire::Encoding;
+use std::collections::HashMap;
+
+/// One topic of a bag.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct TopicStats {
+    /// Topic name.
+    pub name: String,
+    /// Message type as declared (`sensor_msgs/LaserScan`, `sensor_msgs/msg/LaserScan`, …).
+    pub type_name: String,
+    /// What odocal makes of the type.
+    pub kind: MessageKind,
+    /// Serialization of its messages.
+    pub encoding: Encoding,
+    /// Number of messages.
+    pub count: u64,
+    /// Receive (record) time of the first message (ns).
+    pub first_ns: Option<u64>,
+    /// Receive (record) time of the last message (ns).
+    pub last_ns: Option<u64>,
+    /// Bytes of message bodies.
+    pub bytes: u64,
+}
+
+impl TopicStats {
+    /// Messages per second over the topic's time span (`None` with fewer than 2).
+    pub fn rate_hz(&self) -> Option<f64> {
+        let (a, b) = (self.first_ns?, self.last_ns?);
+        (self.count > 1 && b > a).then(|| (self.count - 1) as f64 / ((b - a) as f64 * 1e-9))
+    }
+
+    /// Seconds from the first message to the last.
+    pub fn span_s(&self) -> f64 {
+        match (self.first_ns, self.last_ns) {
+            (Some(a), Some(b)) => b.saturating_sub(a) as f64 * 1e-9,
+            _ => 0.0,
+        }
+    }
+}
+
+/// A decoded laser scan: its fields, receive time and where its ranges are.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ScanRecord {
+    pub(crate) fields: ScanFields,
+    pub(crate) receive_ns: u64,
+    pub(crate) offset: usize,
+    pub(crate) len: usize,
+}
+
+/// The decoded scans of one topic.
+#[derive(Debug, Default)]
+pub(crate) struct ScanTopic {
+    pub(crate) records: Vec<ScanRecord>,
+    pub(crate) ranges: Vec<f32>,
+}
+
+/// One joint's values in one JointState message (NaN where not given).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct JointValue {
+    pub(crate) joint: u32,
+    pub(crate) position: f64,
+    pub(crate) velocity: f64,
+}
+
+/// A decoded JointState message.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct JointRecord {
+    pub(crate) stamp_ns: i64,
+    pub(crate) receive_ns: u64,
+    pub(crate) values: Vec<JointValue>,
+}
+
+/// The decoded joint states of one topic, joint names interned.
+#[derive(Debug, Default)]
+pub(crate) struct JointTopic {
+    pub(crate) names: Vec<String>,
+    index: HashMap<String, u32>,
+    pub(crate) records: Vec<JointRecord>,
+}
+
+impl JointTopic {
+    fn intern(&mut self, name: &str) -> u32 {
+        if let Some(&i) = self.index.get(name) {
+            return i;
+        }
+        let i = self.names.len() as u32;
+        self.names.push(name.to_string());
+        self.index.insert(name.to_string(), i);
+        i
+    }
+
+    /// The index of a joint name, when seen.
+    pub(crate) fn joint(&self, name: &str) -> Option<u32> {
+        self.index.get(name).copied()
+    }
+}
+
+/// Which topics to decode: `None` decodes every topic of that kind.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct DecodeFilter {
+    /// Only this LaserScan topic.
+    pub scan_topic: Option<String>,
+    /// Only this JointState topic.
+    pub joint_states_topic: Option<String>,
+    /// Only this Odometry topic.
+    pub odom_topic: Option<String>,
+    /// Odometry-only mode: joint states are not decoded.
+    pub odometry_only: bool,
+}
+
+/// Everything one pass over a bag gathers.
+#[derive(Debug, Default)]
+pub struct Collected {
+    /// Every topic, in order of first appearance.
+    pub topics: Vec<TopicStats>,
+    by_name: HashMap<String, usize>,
+    decode: Vec<bool>,
+    pub(crate) scans: HashMap<usize, ScanTopic>,
+    pub(crate) joints: HashMap<usize, JointTopic>,
+    pub(crate) odom: HashMap<usize, Vec<(OdometryMsg, u64)>>,
+    filter: DecodeFilter,
+    /// Files read, in order.
+    pub files: Vec<String>,
+    /// Bytes of bag files read.
+    pub bytes_read: u64,
+    /// Notes worth showing once (an unindexed bag, …).
+    pub warnings: Vec<String>,
+}
+
+impl Collected {
+    /// An empty collection decoding what `filter` allows.
+    pub(crate) fn new(filter: DecodeFilter) -> Self {
+        Collected {
+            filter,
+            ..Collected::default()
+        }
+    }
+
+    /// The index of a topic by name.
+    pub fn topic_index(&self, name: &str) -> Option<usize> {
+        self.by_name.get(name).copied()
+    }
+
+    /// Registers a topic (again: split files and ROS 1 connections repeat them) and
+    /// returns its index. A topic declared with two different types is an error.
+    pub(crate) fn topic(
+        &mut self,
+        file: &str,
+        name: &str,
+        type_name: &str,
+        encoding: Encoding,
+    ) -> Result<usize, BagError> {
+        if let Some(&i) = self.by_name.get(name) {
+            let t = &self.topics[i];
+            if t.type_name != type_name || t.encoding != encoding {
+                return Err(BagError::format(
+                    file,
+                    None,
+                    format!(
+                        "topic {name} is declared as {} and as {type_name}",
+                        t.type_name
+                    ),
+                    "record each topic with one message type",
+                ));
+            }
+            return Ok(i);
+        }
+        let kind = MessageKind::of_type(type_name);
+        let wanted = match kind {
+            MessageKind::LaserScan => &self.filter.scan_topic,
+            MessageKind::JointState => &self.filter.joint_states_topic,
+            MessageKind::Odometry => &self.filter.odom_topic,
+            MessageKind::Other => &None,
+        };
+        let skipped = kind == MessageKind::JointState && self.filter.odometry_only;
+        let decode =
+            kind != MessageKind::Other && !skipped && wanted.as_deref().is_none_or(|w| w == name);
+        self.topics.push(TopicStats {
+            name: name.to_string(),
+            type_name: type_name.to_string(),
+            kind,
+            encoding,
+            count: 0,
+            first_ns: None,
+            last_ns: None,
+            bytes: 0,
+        });
+        self.decode.push(decode);
+        let i = self.topics.len() - 1;
+        self.by_name.insert(name.to_string(), i);
+        Ok(i)
+    }
+
+    /// True when messages of topic `i` are decoded (else only counted).
+    pub(crate) fn decodes(&self, i: usize) -> bool {
+        self.decode[i]
+    }
+
+    /// Counts `count` messages of topic `i` received between `first_ns` and `last_ns`.
+    pub(crate) fn count(&mut self, i: usize, count: u64, first_ns: u64, last_ns: u64, bytes: u64) {
+        let t = &mut self.topics[i];
+        t.count += count;
+        t.bytes += bytes;
+        t.first_ns = Some(t.first_ns.map_or(first_ns, |f| f.min(first_ns)));
+        t.last_ns = Some(t.last_ns.map_or(last_ns, |l| l.max(last_ns)));
+    }
+
+    /// One message of topic `i`, received at `receive_ns`: counted, and decoded when
+    /// its topic may be used.
+    pub(crate) fn message(
+        &mut self,
+        file: &str,
+        i: usize,
+        receive_ns: u64,
+        body: &[u8],
+    ) -> Result<(), BagError> {
+        let index = self.topics[i].count;
+        self.count(i, 1, receive_ns, receive_ns, body.len() as u64);
+        if !self.decode[i] {
+            return Ok(());
+        }
+        let t = &self.topics[i];
+        let (kind, encoding) = (t.kind, t.encoding);
+        let fail = |error| BagError::Message {
+            file: file.to_string(),
+            topic: t.name.clone(),
+            type_name: t.type_name.clone(),
+            index,
+            error,
+        };
+        match kind {
+            MessageKind::LaserScan => {
+                let topic = self.scans.entry(i).or_default();
+                let offset = topic.ranges.len();
+                let (fields, len) =
+                    decode_laser_scan(body, encoding, &mut topic.ranges).map_err(fail)?;
+                topic.records.push(ScanRecord {
+                    fields,
+                    receive_ns,
+                    offset,
+                    len,
+                });
+            }
+            MessageKind::JointState => {
+                let msg = decode_joint_state(body, encoding).map_err(fail)?;
+                let topic = self.joints.entry(i).or_default();
+                let n = msg.names.len();
+                let given = |v: &[f64], k: usize| {
+                    if v.len() == n {
+                        v[k]
+                    } else {
+                        f64::NAN
+                    }
+                };
+                let values = (0..n)
+                    .map(|k| JointValue {
+                        joint: topic.intern(msg.names[k]),
+                        position: given(&msg.position, k),
+                        velocity: given(&msg.velocity, k),
+                    })
+                    .collect();
+                topic.records.push(JointRecord {
+                    stamp_ns: msg.stamp_ns,
+                    receive_ns,
+                    values,
+                });
+            }
+            MessageKind::Odometry => {
+                let msg = decode_odometry(body, encoding).map_err(fail)?;
+                self.odom.entry(i).or_default().push((msg, receive_ns));
+            }
+            MessageKind::Other => {}
+        }
+        Ok(())
+    }
+}

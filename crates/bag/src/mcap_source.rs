@@ -1,0 +1,120 @@
+//! MCAP files (ROS 2's default storage), read with Foxglove's `mcap` crate in its
+//! streaming (sans-io) mode: the file is fed in blocks, chunks (zstd, lz4 or
+//! uncompressed) are decompressed one at a time and their CRCs checked.
+
+use crate::collect::Collected;
+use crate::error::{BagError, TRUNCATED_FIX};
+use crate::wire::Encoding;
+use mcap::records::{op, Record};
+use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
+use mcap::McapError;
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::Read;
+use std::path::Path;
+
+/// The first 8 bytes of an MCAP file.
+pub(crate) const MAGIC: &[u8] = b"\x89MCAP0\r\n";
+
+/// The bytes of a message record before its body: channel id (u16), sequence (u32),
+/// log time (u64), publish time (u64).
+const MESSAGE_HEADER: usize = 22;
+
+/// What to tell the user about an error of the `mcap` crate.
+fn advice(e: &McapError) -> &'static str {
+    match e {
+        McapError::UnsupportedCompression(_) => {
+            "odocal reads zstd, lz4 and uncompressed chunks; recompress the file with \
+             `mcap convert` or `ros2 bag convert`"
+        }
+        McapError::BadChunkCrc { .. } | McapError::BadChunkLength { .. } => {
+            "a chunk is damaged; `mcap recover` can copy the readable chunks into a new file"
+        }
+        McapError::BadMagic => "the file is not an MCAP file",
+        _ => TRUNCATED_FIX,
+    }
+}
+
+/// Reads every record of the MCAP file at `path` into `out`.
+pub(crate) fn read_mcap(path: &Path, out: &mut Collected) -> Result<(), BagError> {
+    let name = path.display().to_string();
+    let mut file = File::open(path).map_err(|e| BagError::io(&name, e))?;
+    out.files.push(name.clone());
+    let options = LinearReaderOptions::default()
+        .with_validate_chunk_crcs(true)
+        .with_record_length_limit(1 << 30);
+    let mut reader = LinearReader::new_with_options(options);
+    let mut schemas: HashMap<u16, (String, String)> = HashMap::new();
+    let mut channels: HashMap<u16, usize> = HashMap::new();
+    let mut fed: u64 = 0;
+    while let Some(event) = reader.next_event() {
+        let event = event.map_err(|e| {
+            BagError::format(
+                &name,
+                Some(fed),
+                format!("MCAP: {e} (error found after reading this many bytes)"),
+                advice(&e),
+            )
+        })?;
+        match event {
+            LinearReadEvent::ReadRequest(n) => {
+                let buf = reader.insert(n.max(1 << 16));
+                let got = file.read(buf).map_err(|e| BagError::io(&name, e))?;
+                fed += got as u64;
+                reader.notify_read(got);
+            }
+            LinearReadEvent::Record { opcode, data } => match opcode {
+                op::MESSAGE => {
+                    let Some(head) = data.get(..MESSAGE_HEADER) else {
+                        return Err(BagError::format(
+                            &name,
+                            Some(fed),
+                            "MCAP: a message record shorter than its header",
+                            TRUNCATED_FIX,
+                        ));
+                    };
+                    let channel = u16::from_le_bytes([head[0], head[1]]);
+                    let mut t = [0u8; 8];
+                    t.copy_from_slice(&head[6..14]);
+                    let log_time = u64::from_le_bytes(t);
+                    let Some(&i) = channels.get(&channel) else {
+                        return Err(BagError::format(
+                            &name,
+                            Some(fed),
+                            format!("MCAP: a message on channel {channel} before its channel"),
+                            TRUNCATED_FIX,
+                        ));
+                    };
+                    out.message(&name, i, log_time, &data[MESSAGE_HEADER..])?;
+                }
+                op::SCHEMA | op::CHANNEL => {
+                    let record = mcap::parse_record(opcode, data).map_err(|e| {
+                        BagError::format(&name, Some(fed), format!("MCAP: {e}"), advice(&e))
+                    })?;
+                    match record {
+                        Record::Schema { header, .. } => {
+                            schemas.insert(header.id, (header.name, header.encoding));
+                        }
+                        Record::Channel(c) => {
+                            let type_name = match schemas.get(&c.schema_id) {
+                                Some((n, _)) => n.clone(),
+                                None => String::from("(no schema)"),
+                            };
+                            let (encoding, type_name) = match c.message_encoding.as_str() {
+                                "cdr" => (Encoding::Cdr, type_name),
+                                "ros1" => (Encoding::Ros1, type_name),
+                                other => (Encoding::Cdr, format!("{type_name} ({other})")),
+                            };
+                            let i = out.topic(&name, &c.topic, &type_name, encoding)?;
+                            channels.insert(c.id, i);
+                        }
+                        _ => {}
+                    }
+                }
+                _ => {}
+            },
+        }
+    }
+    out.bytes_read += fed;
+    Ok(())
+}

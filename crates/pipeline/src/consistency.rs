@@ -1,0 +1,251 @@
+//! The two-halves check: the samples of the first and the second half of the log
+//! are calibrated separately, and their difference is compared with its covariance
+//! (the sum of the halves' covariances: they share no sample). Halves that differ
+//! by more than 3σ show that something the model does not include changed during
+//! the log or acts unevenly on it (an unmodelled sweep, a clock offset, wheel slip,
+//! a sensor mounting that moved), even when each half, and the whole, look fine.
+
+use nalgebra::DMatrix;
+use odocal_solver::{calibrate, Calibration, Sample, SolveOptions, PARAMETER_NAMES};
+use serde::Serialize;
+
+/// 99.73 % quantiles of χ² with 1 … 6 degrees of freedom (the "3σ" level).
+const CHI2_3SIGMA: [f64; 6] = [9.0, 11.83, 14.16, 16.25, 18.21, 20.06];
+
+/// |difference| / σ above which a parameter counts as disagreeing.
+pub const Z_LIMIT: f64 = 3.0;
+
+/// The result of the check.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Consistency {
+    /// Both halves were calibrated.
+    Checked(Box<HalvesCheck>),
+    /// A half could not be calibrated (too few samples, not excited, …).
+    NotAvailable {
+        /// Why, in words.
+        reason: String,
+    },
+}
+
+/// Both halves' estimates and how far apart they are.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HalvesCheck {
+    /// Samples used by each half's calibration.
+    pub samples_used: [usize; 2],
+    /// First half's estimate minus the second's (r_L, r_R, b, ℓx, ℓy, ℓθ).
+    pub difference: [f64; 6],
+    /// Standard deviation of the difference (0 for held parameters).
+    pub sigma: [f64; 6],
+    /// Difference in σ (0 for held parameters).
+    pub z: [f64; 6],
+    /// `dᵀ (C₁ + C₂)⁻¹ d` over the parameters not held.
+    pub chi2: f64,
+    /// Its degrees of freedom (parameters not held).
+    pub dof: usize,
+    /// The 3σ (99.73 %) level of χ² with `dof` degrees of freedom.
+    pub chi2_limit: f64,
+    /// Parameters whose halves differ by more than [`Z_LIMIT`] σ.
+    pub disagreeing: Vec<String>,
+    /// Whether the halves agree (χ² and every parameter within 3σ).
+    pub agree: bool,
+    /// In words; when they disagree, the parameters and the likely causes.
+    pub sentence: String,
+}
+
+/// Calibrates the first and the second half of `samples` (in time order) with
+/// `options` (weak halves still give numbers) and compares them.
+pub fn check_halves(samples: &[Sample], options: &SolveOptions) -> Consistency {
+    let half = samples.len() / 2;
+    let opts = SolveOptions {
+        accept_weak: true,
+        ..*options
+    };
+    let solve = |part: &[Sample], name: &str| {
+        calibrate(part, &opts).map_err(|e| format!("the {name} half alone: {e}"))
+    };
+    match (
+        solve(&samples[..half], "first"),
+        solve(&samples[half..], "second"),
+    ) {
+        (Ok(a), Ok(b)) => Consistency::Checked(Box::new(compare(&a, &b, options))),
+        (Err(reason), _) | (_, Err(reason)) => Consistency::NotAvailable { reason },
+    }
+}
+
+fn compare(a: &Calibration, b: &Calibration, options: &SolveOptions) -> HalvesCheck {
+    let difference = a.params.difference(&b.params);
+    let free: Vec<usize> = (0..6)
+        .filter(|&i| !options.constraints.is_held(i))
+        .collect();
+    let combined = |i: usize, j: usize| a.covariance[i][j] + b.covariance[i][j];
+    let mut sigma = [0.0; 6];
+    let mut z = [0.0; 6];
+    for &i in &free {
+        sigma[i] = combined(i, i).max(0.0).sqrt();
+        z[i] = if sigma[i] > 0.0 {
+            difference[i] / sigma[i]
+        } else {
+            0.0
+        };
+    }
+    let n = free.len();
+    let c = DMatrix::from_fn(n, n, |p, q| combined(free[p], free[q]));
+    let d = DMatrix::from_fn(n, 1, |p, _| difference[free[p]]);
+    let chi2 = c
+        .cholesky()
+        .map(|ch| (d.transpose() * ch.solve(&d))[(0, 0)])
+        .unwrap_or(f64::INFINITY);
+    let chi2_limit = CHI2_3SIGMA[n.clamp(1, 6) - 1];
+    let disagreeing: Vec<String> = free
+        .iter()
+        .filter(|&&i| z[i].abs() > Z_LIMIT)
+        .map(|&i| PARAMETER_NAMES[i].to_string())
+        .collect();
+    let agree = disagreeing.is_empty() && chi2 <= chi2_limit;
+    let sentence = if agree {
+        format!(
+            "the two halves of the log agree (χ² {chi2:.1} for {n} parameters, 3σ level {chi2_limit:.1}; largest difference {:.1}σ)",
+            free.iter().map(|&i| z[i].abs()).fold(0.0, f64::max)
+        )
+    } else {
+        disagreement_sentence(&free, &z, chi2, n, chi2_limit)
+    };
+    HalvesCheck {
+        samples_used: [a.samples_used, b.samples_used],
+        difference,
+        sigma,
+        z,
+        chi2,
+        dof: n,
+        chi2_limit,
+        disagreeing,
+        agree,
+        sentence,
+    }
+}
+
+/// "The halves disagree on …: likely …", naming the parameters beyond 3σ (or the
+/// largest ones when only χ² is beyond its level) and the causes that fit them.
+fn disagreement_sentence(free: &[usize], z: &[f64; 6], chi2: f64, n: usize, limit: f64) -> String {
+    let mut named: Vec<usize> = free
+        .iter()
+        .copied()
+        .filter(|&i| z[i].abs() > Z_LIMIT)
+        .collect();
+    if named.is_empty() {
+        let mut by_size = free.to_vec();
+        by_size.sort_by(|&p, &q| z[q].abs().total_cmp(&z[p].abs()));
+        named = by_size.into_iter().take(2).collect();
+    }
+    let list: Vec<String> = named
+        .iter()
+        .map(|&i| format!("{} by {:.1}σ", PARAMETER_NAMES[i], z[i].abs()))
+        .collect();
+    let radii = named.iter().any(|&i| i < 2);
+    let base = named.contains(&2);
+    let laser = named.iter().any(|&i| i >= 3);
+    let sweep = "a range finder that sweeps while the robot moves (give --time-increment \
+                 or the log's laser time increment)";
+    let clock = "a clock offset between laser and encoders (try --estimate-time-offset)";
+    let slip = "wheel slip or a changing load or tyre";
+    let mounting = "a sensor mounting that moved during the log";
+    let causes: Vec<&str> = if laser {
+        vec![sweep, clock, mounting, slip]
+    } else if base {
+        vec![sweep, clock, slip, mounting]
+    } else if radii {
+        vec![slip, clock, sweep, mounting]
+    } else {
+        vec![sweep, clock, slip, mounting]
+    };
+    format!(
+        "the two halves of the log disagree beyond 3σ ({}; χ² {chi2:.1} for {n} parameters, 3σ \
+         level {limit:.1}): something the model does not include changed or acts unevenly, so \
+         the reported σ understate the error; likely causes: {}",
+        list.join(", "),
+        causes.join(", or ")
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use odocal_geom::Pose2;
+    use odocal_solver::{Params, Predictor};
+
+    /// Deterministic noise in [−0.5, 0.5).
+    fn noise(k: usize) -> f64 {
+        let v = ((k as f64) * 12.9898).sin() * 43758.5453;
+        v - v.floor() - 0.5
+    }
+
+    /// 400 samples of a mixed drive; the second half with `second` parameters.
+    fn drive(first: &Params, second: &Params) -> Vec<Sample> {
+        (0..400)
+            .map(|k| {
+                let p = if k < 200 { first } else { second };
+                let scale = 1.0 + 0.5 * noise(7 * k + 1);
+                let (l, r) = [(5.0, 5.0), (-4.0, 4.0), (2.0, 6.0)][k % 3];
+                let s = Sample::from_rotations(0.4, l * scale, r * scale, Pose2::IDENTITY);
+                let sm = Predictor::new(p, true).predict(&s);
+                let e = |c: usize| 2e-3 * noise(7 * k + 2 + c);
+                Sample {
+                    sm: Pose2::new(sm[0] + e(0), sm[1] + e(1), sm[2] + e(2)),
+                    ..s
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn same_robot_agrees_and_a_moved_sensor_does_not() {
+        let robot = Params {
+            r_l: 0.03,
+            r_r: 0.031,
+            b: 0.3,
+            laser: Pose2::new(0.1, 0.02, 0.5),
+        };
+        let opts = SolveOptions::default();
+        let Consistency::Checked(same) = check_halves(&drive(&robot, &robot), &opts) else {
+            panic!("not checked")
+        };
+        assert!(same.agree, "{}", same.sentence);
+        assert_eq!(same.dof, 6);
+        let moved = Params {
+            laser: Pose2::new(0.1, 0.035, 0.5),
+            ..robot
+        };
+        let Consistency::Checked(c) = check_halves(&drive(&robot, &moved), &opts) else {
+            panic!("not checked")
+        };
+        assert!(!c.agree, "{}", c.sentence);
+        assert!(c.disagreeing.contains(&"l_y".to_string()), "{c:?}");
+        assert!(c.sentence.contains("mounting"), "{}", c.sentence);
+        // Holding b removes it from the χ².
+        let mut held = opts;
+        held.constraints.0[2] = odocal_solver::Constraint::Held(0.3);
+        let Consistency::Checked(h) = check_halves(&drive(&robot, &robot), &held) else {
+            panic!("not checked")
+        };
+        assert_eq!((h.dof, h.z[2]), (5, 0.0));
+        // Too few samples for a half: not available, with the reason.
+        let few = drive(&robot, &robot)[..16].to_vec();
+        assert!(matches!(
+            check_halves(&few, &opts),
+            Consistency::NotAvailable { .. }
+        ));
+    }
+
+    #[test]
+    fn sentence_names_parameters_and_causes() {
+        let z = [0.5, 0.4, 4.2, 1.0, 3.5, 0.2];
+        let s = disagreement_sentence(&[0, 1, 2, 3, 4, 5], &z, 40.0, 6, 20.06);
+        assert!(s.contains("b by 4.2σ") && s.contains("l_y by 3.5σ"), "{s}");
+        assert!(!s.contains("r_L"), "{s}");
+        assert!(s.contains("sweeps") && s.contains("clock offset"), "{s}");
+        assert!(s.contains("slip") && s.contains("mounting"), "{s}");
+        let radii = disagreement_sentence(&[0, 1], &[3.5, 3.2, 0.0, 0.0, 0.0, 0.0], 15.0, 2, 11.83);
+        assert!(radii.contains("likely causes: wheel slip"), "{radii}");
+    }
+}
