@@ -7,10 +7,12 @@
 //! runs on the log text, and the recovered parameters are compared:
 //!
 //! - default run: every row at up to [`QUICK_SAMPLES`] samples, every quantity within
-//!   3σ of the reported covariance (fixed seeds);
+//!   [`FAMILY_SIGMAS`] of the reported covariance (fixed seeds): 3σ per quantity would
+//!   be a family of 176 checks that honest σ fail together about 40 % of the time;
+//!   the 3σ rule itself is measured over many seeds by the ignored test;
 //! - ignored (CI: `cargo test --release -p odocal --test table_i -- --include-ignored`):
-//!   every row at its published number of samples with the absolute bounds too, and
-//!   the 3σ rule measured over many seeds.
+//!   every row at its published number of samples with the absolute bounds too (and
+//!   the same family-wise σ bound), and the 3σ rule measured over many seeds.
 
 use odocal_pipeline::sync::TARGET_INTERVAL_S;
 use odocal_pipeline::table_i::{
@@ -28,6 +30,14 @@ const QUICK_SAMPLES: usize = 600;
 
 /// Base seed of the fixed-seed runs.
 const SEED: u64 = 1;
+
+/// Per-quantity bound of the quick run, in reported σ. The quick run checks 22 rows ×
+/// 8 quantities at once; with Gaussian errors and honest σ, P(|z| > 4) per check is
+/// 6.3e-5, so the whole family passes with probability ≈ 99 % (Bonferroni). At 3σ it
+/// would pass with probability 0.9973^176 ≈ 62 % only: with the shared-scan σ model the
+/// seed-1 run has lmov ℓx at 3.48σ, while over 8 other seeds lmov's worst is 2.17σ and
+/// all 1,056 estimates give RMS error/σ 0.96 with 0.5 % beyond 3σ.
+const FAMILY_SIGMAS: f64 = 4.0;
 
 /// The published rows available here: the Table I file's and the T-RO reference's.
 fn published_rows() -> Vec<PublishedRow> {
@@ -96,10 +106,11 @@ fn check_rows(samples_of: impl Fn(&PublishedRow) -> usize, tol: &Tolerances) {
 }
 
 #[test]
-fn quick_rows_are_within_three_sigma() {
-    // 3σ only: the absolute bounds are for runs of 1,000 samples or more.
+fn quick_rows_are_within_the_family_wise_sigma_bound() {
+    // σ only: the absolute bounds are for runs of 1,000 samples or more.
     let tol = Tolerances {
         min_samples_for_bounds: usize::MAX,
+        sigma_multiple: FAMILY_SIGMAS,
         ..Tolerances::default()
     };
     check_rows(|row| (row.samples as usize).min(QUICK_SAMPLES), &tol);
@@ -115,7 +126,12 @@ fn simulated_samples_match_the_pipeline_stride() {
 #[test]
 #[ignore = "full-size rows (75,626 samples) take 1-3 minutes; CI runs them with --include-ignored"]
 fn full_size_rows_meet_every_bound() {
-    let tol = Tolerances::default();
+    // The absolute bounds, and σ with the same family-wise multiple as the quick run
+    // (176 quantities at once); docs/table-i.md gives each row's 3σ verdict.
+    let tol = Tolerances {
+        sigma_multiple: FAMILY_SIGMAS,
+        ..Tolerances::default()
+    };
     check_rows(|row| row.samples as usize, &tol);
 }
 
@@ -159,13 +175,15 @@ fn three_sigma_rule_holds_over_seeds() {
         100.0 * beyond2 as f64 / checks as f64,
         100.0 * beyond3 as f64 / checks as f64
     );
+    // Issue 13's band for honest σ (measured 0.96 with the shared-scan σ model; 0.54
+    // with the independent-samples model before it).
     assert!(
-        rms < 1.5,
+        rms < 1.3,
         "errors are {rms:.2}σ RMS: the covariance is too small"
     );
     assert!(
-        rms > 0.25,
-        "errors are only {rms:.2}σ RMS: the covariance is uselessly pessimistic"
+        rms > 0.7,
+        "errors are only {rms:.2}σ RMS: the covariance is too pessimistic"
     );
     assert!(
         (beyond3 as f64) <= 0.02 * checks as f64,
