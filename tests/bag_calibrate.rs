@@ -5,6 +5,8 @@
 //! velocity-only joint states, a ROS 2 bag directory, and odometry only. Plus bad input:
 //! each a clear error naming the file and what to do.
 
+mod common;
+
 use odocal_bag::{read_bag, BagOptions, TopicChoice};
 use odocal_log::{encoders_from_odometry, NominalWheels, ValueSource, WHEEL_TICKS_PER_REVOLUTION};
 use odocal_pipeline::{calibrate_log, NoProgress, Options};
@@ -55,14 +57,7 @@ fn check(name: &str) {
         .expect("calibration succeeds");
     let report = build_report(&path, &log, &opts, &outcome);
     let est = report.values();
-    let bounds = [
-        0.0035 * truth[0],
-        0.0035 * truth[1],
-        0.0035 * truth[2],
-        1.5e-3,
-        1.5e-3,
-        0.2f64.to_radians(),
-    ];
+    let bounds = common::bounds(&truth);
     let mut failures = Vec::new();
     for i in 0..6 {
         let err = est[i] - truth[i];

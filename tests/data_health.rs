@@ -3,12 +3,14 @@
 //! and the parameters come out within the bounds where the data allow — or the
 //! refusal names the fault.
 
+mod common;
+
 use odocal_log::{read_carmen_from, Log, ReadOptions};
 use odocal_pipeline::{calibrate_log, FaultKind, NoProgress, Options, Outcome, PipelineError};
 use odocal_sim::{simulate, SimConfig};
 
 /// r_L, r_R, b, ℓx, ℓy, ℓθ.
-type Truth = [f64; 6];
+use common::Truth;
 
 /// A simulated log as text lines, and its true parameters.
 fn sim_lines(duration: f64, seed: u64, tweak: impl FnOnce(&mut SimConfig)) -> (Vec<String>, Truth) {
@@ -70,14 +72,7 @@ fn finding(o: &Outcome, kind: FaultKind) -> &odocal_pipeline::Finding {
 /// `loose`, and `k` σ.
 fn assert_within(label: &str, o: &Outcome, truth: &Truth, loose: f64, k: f64) {
     let est = o.calibration.params.to_vector();
-    let bounds = [
-        0.0035 * truth[0],
-        0.0035 * truth[1],
-        0.0035 * truth[2],
-        1.5e-3,
-        1.5e-3,
-        0.2f64.to_radians(),
-    ];
+    let bounds = common::bounds(truth);
     for i in 0..6 {
         let err = est[i] - truth[i];
         let sigma = o.calibration.covariance[i][i].sqrt();

@@ -4,11 +4,13 @@
 //! and within 4σ; heavy slip gives numbers within 4σ or a refusal that names the slip,
 //! never a wrong result labelled "well determined".
 
+mod common;
+
 use odocal_log::{read_carmen_from, ReadOptions};
 use odocal_pipeline::{calibrate_log, NoProgress, Options, Outcome, PipelineError, Trim};
 use odocal_sim::{simulate, SimConfig};
 
-type Truth = [f64; 6];
+use common::Truth;
 
 fn slip_run(
     duration: f64,
@@ -38,14 +40,7 @@ fn slip_run(
 /// (worst error / bound, worst |error| / σ) over the six parameters.
 fn errors(o: &Outcome, truth: &Truth) -> (f64, f64) {
     let est = o.calibration.params.to_vector();
-    let bounds = [
-        0.0035 * truth[0],
-        0.0035 * truth[1],
-        0.0035 * truth[2],
-        1.5e-3,
-        1.5e-3,
-        0.2f64.to_radians(),
-    ];
+    let bounds = common::bounds(truth);
     (0..6).fold((0.0f64, 0.0f64), |(b, s), i| {
         let e = (est[i] - truth[i]).abs();
         (

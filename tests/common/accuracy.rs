@@ -36,14 +36,7 @@ pub fn misses(
     max_sigmas: f64,
 ) -> (Vec<String>, String) {
     let est = report.values();
-    let bounds = [
-        0.0035 * truth[0],
-        0.0035 * truth[1],
-        0.0035 * truth[2],
-        1.5e-3,
-        1.5e-3,
-        0.2f64.to_radians(),
-    ];
+    let bounds = super::bounds(truth);
     let mut failures = Vec::new();
     let mut line = format!("{label}: {} samples;", report.samples_used);
     for i in 0..6 {

@@ -12,6 +12,19 @@ use std::path::{Path, PathBuf};
 /// The six true parameters, in the order r_L, r_R, b, ℓx, ℓy, ℓθ.
 pub type Truth = [f64; 6];
 
+/// The accuracy bounds of the issues for each parameter of `truth`: 0.35 % on r_L, r_R
+/// and b, 1.5 mm on ℓx and ℓy, 0.2° on ℓθ.
+pub fn bounds(truth: &[f64]) -> [f64; 6] {
+    [
+        0.0035 * truth[0],
+        0.0035 * truth[1],
+        0.0035 * truth[2],
+        1.5e-3,
+        1.5e-3,
+        0.2f64.to_radians(),
+    ]
+}
+
 /// A fresh directory under the system's temporary directory.
 pub fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("odocal-e2e-{}-{name}", std::process::id()));

@@ -265,16 +265,7 @@ pub(crate) fn build_log(
     log.scans.sort_by_time();
     log.stats.messages = messages;
     log.stats.warnings.extend(c.warnings.iter().cloned());
-    log.stats.invalid_readings = log
-        .scans
-        .iter()
-        .map(|s| {
-            s.ranges
-                .iter()
-                .filter(|&&r| !s.geometry.is_valid(r))
-                .count() as u64
-        })
-        .sum();
+    log.stats.invalid_readings = log.scans.count_invalid_readings();
     Ok(log)
 }
 

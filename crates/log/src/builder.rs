@@ -199,17 +199,7 @@ impl<'o> LogBuilder<'o> {
         if self.order[Stream::Scan as usize].out_of_order > 0 {
             log.scans.sort_by_time();
         }
-        let invalid = log
-            .scans
-            .iter()
-            .map(|s| {
-                s.ranges
-                    .iter()
-                    .filter(|&&r| !s.geometry.is_valid(r))
-                    .count() as u64
-            })
-            .sum();
-        log.stats.invalid_readings = invalid;
+        log.stats.invalid_readings = log.scans.count_invalid_readings();
         // Memory ≈ the ranges themselves: drop the growth slack of the packed stores.
         log.scans.ranges.shrink_to_fit();
         log.scans.remissions.shrink_to_fit();

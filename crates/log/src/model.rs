@@ -445,6 +445,18 @@ impl ScanStore {
         });
     }
 
+    /// Readings that are not valid ranges (out of range, 0, non-finite), over all scans.
+    pub fn count_invalid_readings(&self) -> u64 {
+        self.iter()
+            .map(|s| {
+                s.ranges
+                    .iter()
+                    .filter(|&&r| !s.geometry.is_valid(r))
+                    .count() as u64
+            })
+            .sum()
+    }
+
     /// Sorts the scans by timestamp (stable: equal timestamps keep file order). The
     /// ranges stay where they are; only the metadata moves.
     pub fn sort_by_time(&mut self) {
