@@ -412,7 +412,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     let (covariance, shared_scan_noise) = match invert_information(&information) {
         Inversion::Covariance(c) => {
             let inverse = zero_held_rows(*c, &constraints);
-            match score_covariance(&active, &params, &weights) {
+            match score_covariance(&active, &params, &weights, &inverse) {
                 Some((score, model)) => (sandwich(&inverse, &score, &constraints), Some(model)),
                 None => (inverse, None),
             }

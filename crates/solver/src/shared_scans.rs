@@ -36,10 +36,15 @@ use std::collections::{BTreeMap, HashMap};
 
 type Matrix6x3 = SMatrix<f64, 6, 3>;
 type Matrix6 = SMatrix<f64, 6, 6>;
+type Matrix3x6 = SMatrix<f64, 3, 6>;
 
 /// Fewest scans shared by two samples used for the shared-scan model to be
 /// estimated (below, the samples are treated as independent).
 pub const MIN_SHARED_SCANS: usize = 20;
+
+/// Fewest samples per window of the long-run estimate of the unshared error (the
+/// residuals stay correlated over 10–30 samples on simulated logs).
+const MIN_WINDOW: usize = 20;
 
 /// The estimated noise of samples that share scans.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -47,12 +52,16 @@ pub struct SharedScanNoise {
     /// Covariance `D` of the error each scan brings into both samples that use
     /// it (x, y, θ in the scan's sensor frame; m², rad²).
     pub per_scan: [[f64; 3]; 3],
-    /// Covariance `N` of the error each sample has alone.
+    /// Long-run covariance `Λ` of the error the samples do not share through a
+    /// scan (per sample; it is correlated over tens of samples, so larger than
+    /// its one-sample variance).
     pub per_sample: [[f64; 3]; 3],
     /// Scans shared by two of the samples used (the pairs `D` was estimated from).
     pub shared_scans: usize,
+    /// Samples per window of the estimate of `per_sample`.
+    pub window: usize,
     /// Per component (x, y, θ): the part of a residual's variance that comes
-    /// from its two scans, `2·D_ii / (N_ii + 2·D_ii)`.
+    /// from its two scans, `2·D_ii / Var(e_i)`.
     pub shared_fraction: [f64; 3],
 }
 
@@ -82,103 +91,118 @@ fn weight(weights: &NoiseWeights, index: usize) -> Matrix3<f64> {
     }
 }
 
-/// Per component: standard error of the mean of every other entry of `v`.
-fn standard_error(v: &[Vector3<f64>]) -> Vector3<f64> {
-    let every_other: Vec<&Vector3<f64>> = v.iter().step_by(2).collect();
-    let m = every_other.len() as f64;
-    if m < 2.0 {
-        return Vector3::zeros();
-    }
-    let mean = every_other.iter().fold(Vector3::zeros(), |acc, x| acc + *x) / m;
-    let var = every_other.iter().fold(Vector3::zeros(), |acc, x| {
-        acc + (*x - mean).component_mul(&(*x - mean))
-    }) / (m - 1.0);
-    var.map(|v| (v / m).sqrt())
-}
-
 fn to_array3(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
     std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
 }
 
+/// Samples per window of the long-run estimate: `√K`, at least
+/// [`MIN_WINDOW`], at most a third of the samples.
+fn window_length(samples: usize) -> usize {
+    ((samples as f64).sqrt() as usize)
+        .max(MIN_WINDOW)
+        .min(samples / 3)
+        .max(1)
+}
+
+/// Running sums of a per-sample quantity: `sum(i, j)` is the sum over `i..j`.
+struct Prefix<T>(Vec<T>);
+
+impl<T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T>> Prefix<T> {
+    fn new(zero: T, items: impl Iterator<Item = T>) -> Self {
+        let mut v = vec![zero];
+        for x in items {
+            let last = v[v.len() - 1];
+            v.push(last + x);
+        }
+        Prefix(v)
+    }
+
+    fn sum(&self, i: usize, j: usize) -> T {
+        self.0[j] - self.0[i]
+    }
+}
+
+/// The per-sample pieces of the residual model at the estimate.
+struct Pieces {
+    /// Residuals `e_k`.
+    e: Vec<Vector3<f64>>,
+    /// Jacobians `G_k` of the prediction.
+    g: Vec<Matrix3x6>,
+    /// `G_kᵀ W_k`.
+    gw: Vec<Matrix6x3>,
+    /// End and start maps `A_k`, `B_k`.
+    a: Vec<Matrix3<f64>>,
+    b: Vec<Matrix3<f64>>,
+    /// Whether sample `k + 1` starts at the scan where sample `k` ends.
+    linked: Vec<bool>,
+}
+
 /// `Var(Σ GᵀWe)` at `params` under the shared-scan model, with the model; `None`
 /// when some sample has no scan times or fewer than [`MIN_SHARED_SCANS`] scans
-/// are shared (then the samples count as independent).
+/// are shared (then the samples count as independent). `h_inv` is the inverse
+/// information of the fit (held parameters' rows zero).
 pub(crate) fn score_covariance(
     samples: &[Packed],
     params: &Params,
     weights: &NoiseWeights,
+    h_inv: &[[f64; 6]; 6],
 ) -> Option<([[f64; 6]; 6], SharedScanNoise)> {
     let times: Vec<[f64; 2]> = samples
         .iter()
         .map(|s| s.scan_times)
         .collect::<Option<_>>()?;
     let pred = Predictor::new(params, true);
-    let (mut e, mut g) = (Vec::new(), Vec::new());
+    let k_all = samples.len();
+    let mut p = Pieces {
+        e: Vec::with_capacity(k_all),
+        g: Vec::with_capacity(k_all),
+        gw: Vec::with_capacity(k_all),
+        a: samples.iter().map(|s| end_map(&s.sm)).collect(),
+        b: samples.iter().map(|s| start_map(&s.sm)).collect(),
+        linked: (0..k_all)
+            .map(|k| k + 1 < k_all && times[k][1].to_bits() == times[k + 1][0].to_bits())
+            .collect(),
+    };
     for s in samples {
-        let (p, jac) = pred.predict_with_jacobian_pieces(s.pieces());
-        e.push(Vector3::from(residual_of(p, &s.sm)));
-        g.push(SMatrix::<f64, 3, 6>::from_fn(|i, j| jac[i][j]));
+        let (pr, jac) = pred.predict_with_jacobian_pieces(s.pieces());
+        let gk = Matrix3x6::from_fn(|i, j| jac[i][j]);
+        p.e.push(Vector3::from(residual_of(pr, &s.sm)));
+        p.gw.push(gk.transpose() * weight(weights, s.index));
+        p.g.push(gk);
     }
-    let starts: HashMap<u64, usize> = times
-        .iter()
-        .enumerate()
-        .map(|(k, t)| (t[0].to_bits(), k))
-        .collect();
-
-    // D from consecutive residuals: B⁻¹ e_{k+1} e_kᵀ A⁻ᵀ (A is a rotation).
-    let mut cross = Matrix3::zeros();
-    let mut shared = 0;
-    // Per shared scan, per component: (e_k² + e_next²)/2 − 2·(shared product), whose
-    // mean is about N_cc: its scatter gives the standard error of N̂.
-    let mut unshared: Vec<Vector3<f64>> = Vec::new();
-    for (k, t) in times.iter().enumerate() {
-        let Some(&next) = starts.get(&t[1].to_bits()) else {
-            continue;
-        };
-        let b_inv = start_map(&samples[next].sm).try_inverse()?;
-        let a = end_map(&samples[k].sm);
-        let product = b_inv * e[next] * e[k].transpose() * a;
-        cross += product;
-        shared += 1;
-        unshared.push(Vector3::from_fn(|c, _| {
-            0.5 * (e[k][c] * e[k][c] + e[next][c] * e[next][c]) - 2.0 * product[(c, c)]
-        }));
-    }
-    if shared < MIN_SHARED_SCANS {
-        return None;
-    }
-    let d = nearest_psd(&(cross / shared as f64));
-    let mut total = Matrix3::zeros();
-    for (s, ek) in samples.iter().zip(&e) {
-        let (a, b) = (end_map(&s.sm), start_map(&s.sm));
-        total += ek * ek.transpose() - a * d * a.transpose() - b * d * b.transpose();
-    }
-    // N is a small difference of large moments: a chance low estimate would make
-    // everything that sums over samples look far too certain. Use its upper bound,
-    // N̂ + SE (SE from every other shared scan, which share no sample).
-    let n_hat = total / samples.len() as f64 + Matrix3::from_diagonal(&standard_error(&unshared));
-    let n = nearest_psd(&n_hat);
-
-    let mut m = Matrix6::zeros();
-    // Ordered by time, so that the sums (and the covariance) are reproducible.
+    let (d, shared) = per_scan_covariance(samples, &times, &p.e)?;
+    // The D part: Σ_j U_j D U_jᵀ, U_j summing GᵀWA and GᵀWB over the samples that
+    // use scan j (ordered by time, so that the sums are reproducible).
     let mut per_scan: BTreeMap<u64, Matrix6x3> = BTreeMap::new();
-    for ((s, gk), t) in samples.iter().zip(&g).zip(&times) {
-        let gw = gk.transpose() * weight(weights, s.index);
-        m += gw * n * gw.transpose();
+    for (k, t) in times.iter().enumerate() {
         *per_scan
             .entry(t[0].to_bits())
-            .or_insert_with(Matrix6x3::zeros) += gw * start_map(&s.sm);
+            .or_insert_with(Matrix6x3::zeros) += p.gw[k] * p.b[k];
         *per_scan
             .entry(t[1].to_bits())
-            .or_insert_with(Matrix6x3::zeros) += gw * end_map(&s.sm);
+            .or_insert_with(Matrix6x3::zeros) += p.gw[k] * p.a[k];
     }
-    for u in per_scan.values() {
-        m += u * d * u.transpose();
-    }
+    let shared_part = per_scan
+        .values()
+        .fold(Matrix6::zeros(), |m, u| m + u * d * u.transpose());
+    let h_inv = Matrix6::from_fn(|i, j| h_inv[i][j]);
+    let window = window_length(k_all);
+    let unshared = long_run_covariance(&p, &d, &shared_part, &h_inv, window);
+    // Λ̂ is itself an estimate: an overlapping-window estimate from K samples in
+    // windows of m is worth about ν = 1.5·K/m degrees of freedom (χ²), and an
+    // error divided by a σ estimated with ν degrees of freedom has variance
+    // ν/(ν − 2): the unshared part is widened by that much.
+    let nu = 1.5 * k_all as f64 / window as f64;
+    let widen = nu / (nu - 2.0).max(1.0);
+    let m = shared_part + widen * unshared_part(&p.gw, &unshared);
+
+    let variance =
+        p.e.iter()
+            .fold(Matrix3::zeros(), |acc, e| acc + e * e.transpose())
+            / k_all as f64;
     let shared_fraction = std::array::from_fn(|i| {
-        let all = n[(i, i)] + 2.0 * d[(i, i)];
-        if all > 0.0 {
-            2.0 * d[(i, i)] / all
+        if variance[(i, i)] > 0.0 {
+            (2.0 * d[(i, i)] / variance[(i, i)]).min(1.0)
         } else {
             0.0
         }
@@ -187,11 +211,103 @@ pub(crate) fn score_covariance(
         std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (m[(i, j)] + m[(j, i)]))),
         SharedScanNoise {
             per_scan: to_array3(&d),
-            per_sample: to_array3(&n),
+            per_sample: to_array3(&unshared),
             shared_scans: shared,
+            window,
             shared_fraction,
         },
     ))
+}
+
+/// `D` from the pairs of consecutive residuals, `B⁻¹ e_{k+1} e_kᵀ A⁻ᵀ` (A is a
+/// rotation), with the number of shared scans; `None` below
+/// [`MIN_SHARED_SCANS`].
+fn per_scan_covariance(
+    samples: &[Packed],
+    times: &[[f64; 2]],
+    e: &[Vector3<f64>],
+) -> Option<(Matrix3<f64>, usize)> {
+    let starts: HashMap<u64, usize> = times
+        .iter()
+        .enumerate()
+        .map(|(k, t)| (t[0].to_bits(), k))
+        .collect();
+    let mut cross = Matrix3::zeros();
+    let mut shared = 0;
+    for (k, t) in times.iter().enumerate() {
+        let Some(&next) = starts.get(&t[1].to_bits()) else {
+            continue;
+        };
+        let b_inv = start_map(&samples[next].sm).try_inverse()?;
+        cross += b_inv * e[next] * e[k].transpose() * end_map(&samples[k].sm);
+        shared += 1;
+    }
+    if shared < MIN_SHARED_SCANS {
+        return None;
+    }
+    Some((nearest_psd(&(cross / shared as f64)), shared))
+}
+
+/// `Σ_k G_kᵀW_k Λ W_kG_k`.
+fn unshared_part(gw: &[Matrix6x3], lambda: &Matrix3<f64>) -> Matrix6 {
+    gw.iter()
+        .fold(Matrix6::zeros(), |m, a| m + a * lambda * a.transpose())
+}
+
+/// Λ: the long-run covariance of the part of the residuals that the scans do not
+/// share, from sums over overlapping windows of `window` consecutive samples.
+///
+/// A window's sum `S_w = Σ e_k` holds the shared scan errors only through the
+/// scans at its ends (and the small differences `A_k + B_{k+1}` of the maps of
+/// the scans inside it): their variance `V_w` under `D` is subtracted. The
+/// residuals come from the fit, which removes from each window the part
+/// `G_w Δ` (`Δ` the estimate's error): `E[S_w S_wᵀ]` is smaller than the true one by
+/// `X_w + X_wᵀ − G_w C G_wᵀ` with `X_w = G_w H⁻¹ (Σ_w GᵀW) Λ` and `C` the
+/// covariance; that is added back (REML-style, with Λ from the uncorrected
+/// sums).
+fn long_run_covariance(
+    p: &Pieces,
+    d: &Matrix3<f64>,
+    shared_part: &Matrix6,
+    h_inv: &Matrix6,
+    window: usize,
+) -> Matrix3<f64> {
+    let k_all = p.e.len();
+    let m = window;
+    // What scan j between samples k and k+1 adds to a window that holds both.
+    let junction: Vec<Matrix3<f64>> = (0..k_all.saturating_sub(1))
+        .map(|k| {
+            let (a, b) = (p.a[k], p.b[k + 1]);
+            if p.linked[k] {
+                (a + b) * d * (a + b).transpose()
+            } else {
+                a * d * a.transpose() + b * d * b.transpose()
+            }
+        })
+        .collect();
+    let inner = Prefix::new(Matrix3::zeros(), junction.into_iter());
+    let sums = Prefix::new(Vector3::zeros(), p.e.iter().copied());
+    let g_sums = Prefix::new(Matrix3x6::zeros(), p.g.iter().copied());
+    let gw_sums = Prefix::new(Matrix6x3::zeros(), p.gw.iter().copied());
+    let mut raw = Matrix3::zeros();
+    let windows = k_all + 1 - m;
+    for i in 0..windows {
+        let j = i + m;
+        let s = sums.sum(i, j);
+        let ends = p.b[i] * d * p.b[i].transpose() + p.a[j - 1] * d * p.a[j - 1].transpose();
+        raw += s * s.transpose() - ends - inner.sum(i, j - 1);
+    }
+    let count = (windows * m) as f64;
+    let lambda = nearest_psd(&(raw / count));
+
+    let c = h_inv * (unshared_part(&p.gw, &lambda) + shared_part) * h_inv;
+    let mut removed = Matrix3::zeros();
+    for i in 0..windows {
+        let g_w = g_sums.sum(i, i + m);
+        let x = g_w * h_inv * gw_sums.sum(i, i + m) * lambda;
+        removed += x + x.transpose() - g_w * c * g_w.transpose();
+    }
+    nearest_psd(&((raw + removed) / count))
 }
 
 #[cfg(test)]
