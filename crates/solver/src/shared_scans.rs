@@ -10,21 +10,36 @@
 //! of everything that sums over many samples (the radii and `b` most), by a factor
 //! 2–3 on those logs.
 //!
-//! The model: `ŝ_k = ŝ_k,true ⊖δ_start ⊕ … ⊕δ_end + n_k`, i.e. to first order
-//! `e_k = A_k δ_end(k) + B_k δ_start(k) + n_k` with one error `δ_j` per scan
-//! (covariance `D`, in the scan's sensor frame) and one per sample (`N`):
-//! `A_k = diag(R(ŝθ), 1)` maps the end scan's error into `ŝ_k`, `B_k` (−1 on the
-//! diagonal, `(ŝy, −ŝx)` in the θ column) the start scan's. Then
-//! `E[e_{k+1} e_kᵀ] = B_{k+1} D A_kᵀ` gives `D` from the pairs of consecutive
-//! residuals, and `E[e_k e_kᵀ] = N + A_k D A_kᵀ + B_k D B_kᵀ` gives `N`. The
-//! estimator is unchanged (weighted least squares); its covariance is the sandwich
-//! `H⁻¹ Var(Σ GᵀWe) H⁻¹` with `Var(Σ GᵀWe) = Σ_k GᵀWNWG + Σ_j U_j D U_jᵀ`,
+//! The model: `ŝ_k = ŝ_k,true ⊖δ_start ⊕ … ⊕δ_end + u_k`, i.e. to first order
+//! `e_k = A_k δ_end(k) + B_k δ_start(k) + u_k` with one error `δ_j` per scan
+//! (covariance `D`, in the scan's sensor frame) and an error `u_k` the samples do
+//! not share through a scan: `A_k = diag(R(ŝθ), 1)` maps the end scan's error
+//! into `ŝ_k`, `B_k` (−1 on the diagonal, `(ŝy, −ŝx)` in the θ column) the start
+//! scan's. `E[e_{k+1} e_kᵀ] = B_{k+1} D A_kᵀ` gives `D` from the pairs of
+//! consecutive residuals.
+//!
+//! `u` is not white: on simulated logs the residuals stay slightly positively
+//! correlated over 2–30 samples (autocorrelations within ±0.04, summing to about
+//! +0.02; likely the matcher's error following the slowly changing scene): nothing
+//! next to the lag-1 −0.45 but is as large as the part that survives summation:
+//! the long-run variance of the residuals (what sums over many samples see) is
+//! 1.6× the lag-0/lag-1 value on Khepera logs. So `u` enters through its long-run
+//! covariance `Λ`, estimated from the sums of the residuals over overlapping
+//! windows of `m = max(20, √K)` samples: each window sum holds `m·Λ` plus the
+//! shared errors of the scans at its ends (subtracted with `D`), less the part
+//! the fit removed from it (added back, as REML does for a variance). The
+//! estimator is unchanged (weighted least squares); its covariance is the
+//! sandwich `H⁻¹ Var(Σ GᵀWe) H⁻¹` with `Var(Σ GᵀWe) = Σ_k GᵀWΛWG + Σ_j U_j D U_jᵀ`,
 //! `U_j` summing `GᵀWA` and `GᵀWB` over the samples that use scan `j`.
 //!
-//! `N` is a small difference of large moments (70–90 % of the residual variance is
-//! shared on simulated logs), so its estimate is noisy, and a chance low estimate
-//! would make everything that sums over samples look far too certain: it enters at
-//! its estimate plus one standard error (σ lean large by up to ~30 %, measured).
+//! `Λ̂` is a small quantity (80–95 % of a residual's variance is the two scans')
+//! estimated from about `1.5·K/m` windows' worth of data, and a chance low
+//! estimate would make everything that sums over samples look too certain. Its
+//! uncertainty is propagated: with `ν` the χ² degrees of freedom the estimate is
+//! worth, an error over σ is Student-t, variance `ν/(ν − 2)`, and each component
+//! of `Λ̂` is widened by that (see `LongRun::widened`). An earlier version used the
+//! lag-0 variance `N` at its moment estimate plus one standard error: σ 10–50 %
+//! too large on the radii, and it missed the long-range part.
 
 use crate::kinematics::{residual_of, Predictor};
 use crate::noise::NoiseWeights;
@@ -187,14 +202,9 @@ pub(crate) fn score_covariance(
         .fold(Matrix6::zeros(), |m, u| m + u * d * u.transpose());
     let h_inv = Matrix6::from_fn(|i, j| h_inv[i][j]);
     let window = window_length(k_all);
-    let unshared = long_run_covariance(&p, &d, &shared_part, &h_inv, window);
-    // Λ̂ is itself an estimate: an overlapping-window estimate from K samples in
-    // windows of m is worth about ν = 1.5·K/m degrees of freedom (χ²), and an
-    // error divided by a σ estimated with ν degrees of freedom has variance
-    // ν/(ν − 2): the unshared part is widened by that much.
-    let nu = 1.5 * k_all as f64 / window as f64;
-    let widen = nu / (nu - 2.0).max(1.0);
-    let m = shared_part + widen * unshared_part(&p.gw, &unshared);
+    let long_run = long_run_covariance(&p, &d, &shared_part, &h_inv, window);
+    let unshared = long_run.widened();
+    let m = shared_part + unshared_part(&p.gw, &unshared);
 
     let variance =
         p.e.iter()
@@ -211,7 +221,7 @@ pub(crate) fn score_covariance(
         std::array::from_fn(|i| std::array::from_fn(|j| 0.5 * (m[(i, j)] + m[(j, i)]))),
         SharedScanNoise {
             per_scan: to_array3(&d),
-            per_sample: to_array3(&unshared),
+            per_sample: to_array3(&long_run.lambda),
             shared_scans: shared,
             window,
             shared_fraction,
@@ -248,6 +258,36 @@ fn per_scan_covariance(
     Some((nearest_psd(&(cross / shared as f64)), shared))
 }
 
+/// The estimate of Λ and what it is worth.
+struct LongRun {
+    /// Λ̂.
+    lambda: Matrix3<f64>,
+    /// Per component: the mean square of the window sums over its part `m·Λ̂_cc`
+    /// (the rest is the scans' shared error at the windows' ends).
+    inflation: Vector3<f64>,
+    /// Overlapping windows of `window` samples out of `samples`.
+    samples: usize,
+    window: usize,
+}
+
+impl LongRun {
+    /// Λ̂ widened by its own uncertainty. The overlapping-window estimate of a
+    /// long-run variance from K samples in windows of m has the variance of a
+    /// χ² with ν₀ = 1.5·K/m degrees of freedom; here each window sum also holds
+    /// the shared error of its end scans, which adds noise but no signal: ν =
+    /// ν₀ / (inflation)². An error divided by a σ estimated with ν degrees of
+    /// freedom has variance ν/(ν − 2) (Student's t): each component of Λ̂ is
+    /// widened by that much.
+    fn widened(&self) -> Matrix3<f64> {
+        let nu0 = 1.5 * self.samples as f64 / self.window as f64;
+        let scale = self.inflation.map(|r| {
+            let nu = nu0 / (r * r);
+            (nu / (nu - 2.0).max(0.2)).sqrt()
+        });
+        Matrix3::from_diagonal(&scale) * self.lambda * Matrix3::from_diagonal(&scale)
+    }
+}
+
 /// `Σ_k G_kᵀW_k Λ W_kG_k`.
 fn unshared_part(gw: &[Matrix6x3], lambda: &Matrix3<f64>) -> Matrix6 {
     gw.iter()
@@ -271,7 +311,7 @@ fn long_run_covariance(
     shared_part: &Matrix6,
     h_inv: &Matrix6,
     window: usize,
-) -> Matrix3<f64> {
+) -> LongRun {
     let k_all = p.e.len();
     let m = window;
     // What scan j between samples k and k+1 adds to a window that holds both.
@@ -290,12 +330,14 @@ fn long_run_covariance(
     let g_sums = Prefix::new(Matrix3x6::zeros(), p.g.iter().copied());
     let gw_sums = Prefix::new(Matrix6x3::zeros(), p.gw.iter().copied());
     let mut raw = Matrix3::zeros();
+    let mut squares = Vector3::zeros();
     let windows = k_all + 1 - m;
     for i in 0..windows {
         let j = i + m;
         let s = sums.sum(i, j);
         let ends = p.b[i] * d * p.b[i].transpose() + p.a[j - 1] * d * p.a[j - 1].transpose();
         raw += s * s.transpose() - ends - inner.sum(i, j - 1);
+        squares += s.component_mul(&s);
     }
     let count = (windows * m) as f64;
     let lambda = nearest_psd(&(raw / count));
@@ -307,7 +349,21 @@ fn long_run_covariance(
         let x = g_w * h_inv * gw_sums.sum(i, i + m) * lambda;
         removed += x + x.transpose() - g_w * c * g_w.transpose();
     }
-    nearest_psd(&((raw + removed) / count))
+    let lambda = nearest_psd(&((raw + removed) / count));
+    let inflation = Vector3::from_fn(|c, _| {
+        let signal = m as f64 * lambda[(c, c)];
+        if signal > 0.0 {
+            squares[c] / windows as f64 / signal
+        } else {
+            1.0
+        }
+    });
+    LongRun {
+        lambda,
+        inflation,
+        samples: k_all,
+        window,
+    }
 }
 
 #[cfg(test)]
