@@ -1,12 +1,11 @@
 //! The report of a calibration: what `--json` prints and `results.json` holds, and
 //! the human summary.
 
-use crate::finding::{Finding, Severity};
 use crate::provenance::Provenance;
 use odocal_log::Log;
 use odocal_pipeline::consistency::Consistency;
 use odocal_pipeline::sync::DiscardCounts;
-use odocal_pipeline::{Estimate, Options, Outcome, Timing};
+use odocal_pipeline::{Estimate, Finding, FindingKind, Options, Outcome, Timing};
 use odocal_solver::{Constraint, Observability, SharedScanNoise, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
@@ -20,7 +19,7 @@ pub struct Report {
     /// What the reader found in it.
     pub log_contents: LogContents,
     /// The data-health findings: each fault found, what was done, what the user can do.
-    pub health: Vec<odocal_pipeline::Finding>,
+    pub health: Vec<Finding>,
     /// Left wheel radius (m).
     pub r_l: f64,
     /// Right wheel radius (m).
@@ -139,22 +138,15 @@ pub struct Settings {
 /// The two-halves check as a finding: a note when the halves agree or could not
 /// be checked, a warning when they disagree beyond 3σ.
 fn two_halves(c: &Consistency) -> Finding {
-    let (severity, message) = match c {
-        Consistency::Checked(h) if h.agree => (Severity::Info, h.sentence.clone()),
-        Consistency::Checked(h) => (Severity::Warning, h.sentence.clone()),
-        Consistency::NotAvailable { reason } => (
-            Severity::Info,
+    match c {
+        Consistency::Checked(h) if h.agree => {
+            Finding::note(FindingKind::TwoHalves, h.sentence.clone())
+        }
+        Consistency::Checked(h) => Finding::warning(FindingKind::TwoHalves, h.sentence.clone()),
+        Consistency::NotAvailable { reason } => Finding::note(
+            FindingKind::TwoHalves,
             format!("the two halves of the log were not compared: {reason}"),
         ),
-    };
-    Finding {
-        kind: "two_halves".into(),
-        severity,
-        count: 1,
-        first_line: None,
-        time: None,
-        spans: Vec::new(),
-        message,
     }
 }
 

@@ -18,104 +18,10 @@ pub mod slip;
 pub mod spikes;
 pub mod wraps;
 
+use crate::finding::Finding;
 use crate::run::{Options, Synchronized};
 use odocal_log::{EncoderRecord, Log, ScanMeta, ScanStore};
-use serde::Serialize;
 use std::borrow::Cow;
-use std::fmt;
-
-/// What kind of data fault a finding is about.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FaultKind {
-    /// Encoder counters wrapping with no modulus given.
-    EncoderWrap,
-    /// A stream's clock jumping backwards.
-    ClockJump,
-    /// Records slightly out of timestamp order (sorted by the reader).
-    OutOfOrder,
-    /// Records repeated exactly.
-    Duplicate,
-    /// Different records with the same timestamp (rounded timestamps).
-    TimestampCollision,
-    /// The laser repeating one scan.
-    FrozenScan,
-    /// Encoder counts jumping at a physically impossible wheel speed.
-    EncoderSpike,
-    /// A stream with a hole.
-    Gap,
-    /// A large offset between the laser clock and the encoder clock.
-    ClockOffset,
-    /// Scan matching and odometry disagreeing in rotation (wheel slip).
-    Slip,
-}
-
-impl FaultKind {
-    /// The snake_case name used in the JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            FaultKind::EncoderWrap => "encoder_wrap",
-            FaultKind::ClockJump => "clock_jump",
-            FaultKind::OutOfOrder => "out_of_order",
-            FaultKind::Duplicate => "duplicate",
-            FaultKind::TimestampCollision => "timestamp_collision",
-            FaultKind::FrozenScan => "frozen_scan",
-            FaultKind::EncoderSpike => "encoder_spike",
-            FaultKind::Gap => "gap",
-            FaultKind::ClockOffset => "clock_offset",
-            FaultKind::Slip => "slip",
-        }
-    }
-}
-
-/// How much a finding matters.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Severity {
-    /// Noted; the results are not affected.
-    Info,
-    /// Data were changed or left out, or the results may be affected.
-    Warning,
-}
-
-/// One data fault: what, how often, where, what was done and what the user can do.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Finding {
-    /// The kind of fault.
-    pub kind: FaultKind,
-    /// How much it matters.
-    pub severity: Severity,
-    /// How many records, samples or episodes it concerns.
-    pub count: u64,
-    /// 1-based line of the first occurrence, when known.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub first_line: Option<u64>,
-    /// Timestamp (s, the stream's own clock) of the first occurrence, when known.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub time: Option<f64>,
-    /// What was found, what was done, what the user can do.
-    pub message: String,
-}
-
-impl fmt::Display for Finding {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let level = match self.severity {
-            Severity::Info => "note",
-            Severity::Warning => "warning",
-        };
-        write!(f, "{level} [{}]: {}", self.kind.name(), self.message)
-    }
-}
-
-/// The findings that can explain a refusal (warnings), joined into one sentence.
-pub fn explain(findings: &[Finding]) -> Option<String> {
-    let w: Vec<&str> = findings
-        .iter()
-        .filter(|f| f.severity == Severity::Warning)
-        .map(|f| f.message.as_str())
-        .collect();
-    (!w.is_empty()).then(|| w.join("; "))
-}
 
 /// The encoder records and scans in the order they appear in the file (by line; the
 /// reader sorts each stream by timestamp).
