@@ -23,10 +23,7 @@ fn sim_lines(duration: f64, seed: u64, tweak: impl FnOnce(&mut SimConfig)) -> (V
     let summary = run.write_log(&mut bytes, &[]).expect("log written");
     let p = run.ground_truth(&summary).params;
     let text = String::from_utf8(bytes).expect("text");
-    (
-        text.lines().map(String::from).collect(),
-        [p.r_l, p.r_r, p.b, p.l_x, p.l_y, p.l_theta],
-    )
+    (text.lines().map(String::from).collect(), p.to_array())
 }
 
 fn read(lines: &[String]) -> Log {

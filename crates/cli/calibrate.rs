@@ -214,9 +214,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 serde_json::json!({
                     "nominal": {"r_l": nominal.r_l, "r_r": nominal.r_r, "b": nominal.b},
                     "correction_factors": {
-                        "r_l": report.r_l / nominal.r_l,
-                        "r_r": report.r_r / nominal.r_r,
-                        "b": report.b / nominal.b,
+                        "r_l": report.params.r_l / nominal.r_l,
+                        "r_r": report.params.r_r / nominal.r_r,
+                        "b": report.params.b / nominal.b,
                     },
                 }),
             );
@@ -232,9 +232,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 n.r_l,
                 n.r_r,
                 n.b,
-                report.r_l / n.r_l,
-                report.r_r / n.r_r,
-                report.b / n.b
+                report.params.r_l / n.r_l,
+                report.params.r_r / n.r_r,
+                report.params.b / n.b
             );
         }
     }

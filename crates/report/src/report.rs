@@ -2,6 +2,7 @@
 //! the human summary.
 
 use crate::provenance::Provenance;
+use odocal_geom::FlatParams;
 use odocal_log::Log;
 use odocal_pipeline::consistency::Consistency;
 use odocal_pipeline::sync::DiscardCounts;
@@ -20,18 +21,9 @@ pub struct Report {
     pub log_contents: LogContents,
     /// The data-health findings: each fault found, what was done, what the user can do.
     pub health: Vec<Finding>,
-    /// Left wheel radius (m).
-    pub r_l: f64,
-    /// Right wheel radius (m).
-    pub r_r: f64,
-    /// Wheel distance (m).
-    pub b: f64,
-    /// Laser x on the robot (m).
-    pub l_x: f64,
-    /// Laser y on the robot (m).
-    pub l_y: f64,
-    /// Laser heading on the robot (rad).
-    pub l_theta: f64,
+    /// The estimate: fields `r_l`, `r_r`, `b`, `l_x`, `l_y`, `l_theta` (m, rad).
+    #[serde(flatten)]
+    pub params: FlatParams,
     /// Standard deviations, order r_L, r_R, b, ℓx, ℓy, ℓθ.
     pub sigma: [f64; 6],
     /// Covariance 6×6, order r_L, r_R, b, ℓx, ℓy, ℓθ.
@@ -165,12 +157,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             unknown_messages: log.stats.unknown.values().sum(),
         },
         health: outcome.health.clone(),
-        r_l: v[0],
-        r_r: v[1],
-        b: v[2],
-        l_x: v[3],
-        l_y: v[4],
-        l_theta: v[5],
+        params: FlatParams::from_array(v),
         sigma: e.sigma,
         covariance: e.covariance,
         j: e.j,
@@ -227,7 +214,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
 impl Report {
     /// The estimate as `[r_L, r_R, b, ℓx, ℓy, ℓθ]`.
     pub fn values(&self) -> [f64; 6] {
-        [self.r_l, self.r_r, self.b, self.l_x, self.l_y, self.l_theta]
+        self.params.to_array()
     }
 }
 
