@@ -12,6 +12,8 @@ use std::fmt;
 pub enum FindingKind {
     /// Encoder counters wrapping with no modulus given.
     EncoderWrap,
+    /// Wheel angles in radians wrapped to one turn (ROS continuous joints).
+    WheelAngleWrap,
     /// A stream's clock jumping backwards.
     ClockJump,
     /// Records slightly out of timestamp order (sorted by the reader).
@@ -39,6 +41,7 @@ impl FindingKind {
     pub fn name(self) -> &'static str {
         match self {
             FindingKind::EncoderWrap => "encoder_wrap",
+            FindingKind::WheelAngleWrap => "wheel_angle_wrap",
             FindingKind::ClockJump => "clock_jump",
             FindingKind::OutOfOrder => "out_of_order",
             FindingKind::Duplicate => "duplicate",

@@ -4,11 +4,13 @@
 //!
 //! Before synchronization ([`check_log`], on the log): clock jumps and records out of
 //! order ([`clock`]), duplicated records and colliding timestamps ([`duplicates`]),
-//! frozen scans ([`frozen`]), encoder counter wraps without a modulus ([`wraps`]),
+//! frozen scans ([`frozen`]), wheel angles wrapped to one turn ([`angle_wraps`]),
+//! encoder counter wraps without a modulus ([`wraps`]),
 //! physically impossible encoder jumps ([`spikes`]), gaps ([`gaps`]). After matching
 //! ([`after_matching`], on the samples): a large laser–encoder clock offset
 //! ([`clock_offset`]) and wheel-slip episodes ([`slip`]).
 
+pub mod angle_wraps;
 pub mod clock;
 pub mod clock_offset;
 pub mod duplicates;
@@ -20,7 +22,9 @@ pub mod wraps;
 
 use crate::finding::Finding;
 use crate::run::{Options, Synchronized};
-use odocal_log::{EncoderRecord, Log, ScanMeta, ScanStore};
+use odocal_log::{
+    EncoderRecord, Log, ScanMeta, ScanStore, ValueSource, WHEEL_TICKS_PER_REVOLUTION,
+};
 use std::borrow::Cow;
 
 /// The encoder records and scans in the order they appear in the file (by line; the
@@ -34,6 +38,15 @@ pub(crate) fn in_file_order<T: Copy>(items: &[T], line: impl Fn(&T) -> u64) -> V
 /// Seconds from `t0` to `t`, for messages ("12.4 s into the log").
 pub(crate) fn since(t: f64, t0: f64) -> String {
     format!("{:.2} s into the log", t - t0)
+}
+
+/// True when the log's counts are wheel angles read in radians (ROS joint states,
+/// odometry), at [`WHEEL_TICKS_PER_REVOLUTION`] ticks per turn by convention.
+fn angles_in_radians(log: &Log) -> bool {
+    matches!(
+        log.params.ticks_per_revolution,
+        Some((t, ValueSource::Convention)) if t == WHEEL_TICKS_PER_REVOLUTION
+    )
 }
 
 /// Checks the log before synchronization and repairs what is safe to repair. Returns
@@ -61,6 +74,9 @@ pub fn check_log<'a>(log: &'a Log, opts: &Options) -> (Cow<'a, Log>, Vec<Finding
     findings.extend(duplicates::encoders(&mut encoders));
     findings.extend(duplicates::scans(&mut scans, &log.scans));
     findings.extend(frozen::scans(&mut scans, &log.scans));
+    if angles_in_radians(log) {
+        findings.extend(angle_wraps::unwrap(&mut encoders));
+    }
     if log.params.encoder_modulus.is_none() {
         findings.extend(wraps::unwrap(&mut encoders));
     }
