@@ -24,7 +24,9 @@ pub struct EncoderConfig {
     /// the encoder counts with each scan; with a clock offset, the counts are read
     /// that much after the scan's first ray). `jitter_s` then moves the time the
     /// counts are read, not their timestamp.
-    #[serde(default)]
+    /// (Left out of the JSON when off, so configurations written before it read and
+    /// write back the same.)
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub with_scans: bool,
 }
 
