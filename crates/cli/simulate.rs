@@ -67,6 +67,10 @@ pub struct Args {
     /// Encoder timing jitter (± s, uniform).
     #[arg(long)]
     encoder_jitter: Option<f64>,
+    /// One encoder record per scan, with the scan's timestamp (a log that stores the
+    /// counts with each scan), instead of --encoder-rate.
+    #[arg(long)]
+    encoder_with_scans: bool,
     /// Scans per second.
     #[arg(long)]
     scan_rate: Option<f64>,
@@ -84,7 +88,8 @@ pub struct Args {
     /// World: khepera-arena, office, corridor or hall.
     #[arg(long)]
     world: Option<String>,
-    /// Trajectory: mixed, straight-only, spin-only or identical-turns.
+    /// Trajectory: mixed, straight-only, spin-only, identical-turns or no-spins (a joystick
+    /// drive: straights and arcs, no spins in place).
     #[arg(long)]
     trajectory: Option<String>,
     /// Range noise standard deviation per reading (m).
@@ -126,7 +131,7 @@ pub struct Args {
     /// Smallest distance to walls kept by the planner (m).
     #[arg(long)]
     clearance: Option<f64>,
-    /// Radius of the identical-turns circle (m).
+    /// Radius of the identical-turns circle, smallest turning radius of no-spins (m).
     #[arg(long)]
     turn_radius: Option<f64>,
     /// Encoder-clock time of the start (s).
@@ -237,6 +242,7 @@ fn apply_overrides(c: &mut SimConfig, a: &Args) -> anyhow::Result<()> {
     }
     set(&mut c.encoder.rate_hz, a.encoder_rate);
     set(&mut c.encoder.jitter_s, a.encoder_jitter);
+    c.encoder.with_scans |= a.encoder_with_scans;
     set(&mut c.laser.rate_hz, a.scan_rate);
     set(&mut c.laser.jitter_s, a.scan_jitter);
     if let Some(w) = &a.world {

@@ -19,6 +19,15 @@ pub struct EncoderConfig {
     pub modulus: Option<u64>,
     /// Counter values `[left, right]` when the wheels are at their start angle.
     pub initial_ticks: [i64; 2],
+    /// One record per scan instead of `rate_hz`: the counts read when the laser clock
+    /// shows the scan's timestamp, and written with that timestamp (a log that stores
+    /// the encoder counts with each scan; with a clock offset, the counts are read
+    /// that much after the scan's first ray). `jitter_s` then moves the time the
+    /// counts are read, not their timestamp.
+    /// (Left out of the JSON when off, so configurations written before it read and
+    /// write back the same.)
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub with_scans: bool,
 }
 
 impl Default for EncoderConfig {
@@ -30,6 +39,7 @@ impl Default for EncoderConfig {
             jitter_s: 0.002,
             modulus: None,
             initial_ticks: [0, 0],
+            with_scans: false,
         }
     }
 }

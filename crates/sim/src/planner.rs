@@ -8,6 +8,11 @@
 //! - [`TrajectoryKind::SpinOnly`]: rotations in place only.
 //! - [`TrajectoryKind::IdenticalTurns`]: driving (forward and backward, at varying
 //!   speeds) along one circle, so every motion has the same curvature.
+//! - [`TrajectoryKind::NoSpins`]: like a person driving the robot around with a
+//!   joystick: straight runs and arcs of varied curvature (radius at least
+//!   [`MotionLimits::turn_radius`]) and speed, mostly forward, a few short pauses,
+//!   never a spin in place. Each run is checked against the world first; a robot facing a wall
+//!   backs out along an arc.
 //!
 //! The degenerate kinds command wheel speeds in a fixed ratio; since both motors have
 //! the same lag, the ratio holds at every instant and the motion really is degenerate.
@@ -33,19 +38,30 @@ pub enum TrajectoryKind {
     SpinOnly,
     /// Always the same curvature (one circle).
     IdenticalTurns,
+    /// Straights and arcs of varied curvature and speed, no spins in place (a
+    /// joystick drive).
+    NoSpins,
 }
 
 /// Names accepted by [`TrajectoryKind::from_name`].
-pub const TRAJECTORY_NAMES: [&str; 4] = ["mixed", "straight-only", "spin-only", "identical-turns"];
+pub const TRAJECTORY_NAMES: [&str; 5] = [
+    "mixed",
+    "straight-only",
+    "spin-only",
+    "identical-turns",
+    "no-spins",
+];
 
 impl TrajectoryKind {
-    /// The kind named `mixed`, `straight-only`, `spin-only` or `identical-turns`.
+    /// The kind named `mixed`, `straight-only`, `spin-only`, `identical-turns` or
+    /// `no-spins`.
     pub fn from_name(name: &str) -> Result<Self, SimError> {
         match name {
             "mixed" => Ok(TrajectoryKind::Mixed),
             "straight-only" | "straight" => Ok(TrajectoryKind::StraightOnly),
             "spin-only" | "spin" => Ok(TrajectoryKind::SpinOnly),
             "identical-turns" => Ok(TrajectoryKind::IdenticalTurns),
+            "no-spins" => Ok(TrajectoryKind::NoSpins),
             _ => Err(SimError::UnknownName {
                 what: "trajectory",
                 name: name.to_string(),
@@ -61,6 +77,7 @@ impl TrajectoryKind {
             TrajectoryKind::StraightOnly => "straight-only",
             TrajectoryKind::SpinOnly => "spin-only",
             TrajectoryKind::IdenticalTurns => "identical-turns",
+            TrajectoryKind::NoSpins => "no-spins",
         }
     }
 }
@@ -74,7 +91,8 @@ pub struct MotionLimits {
     pub max_turn_rate: f64,
     /// Smallest distance (m) the planned paths keep from any wall.
     pub clearance: f64,
-    /// Radius (m) of the circle driven by [`TrajectoryKind::IdenticalTurns`].
+    /// Radius (m) of the circle driven by [`TrajectoryKind::IdenticalTurns`], and
+    /// the smallest turning radius of [`TrajectoryKind::NoSpins`].
     pub turn_radius: f64,
 }
 
@@ -126,7 +144,13 @@ enum Maneuver {
         floor: f64,
     },
     /// Drive at constant body velocity `(v, v·curvature)` until the given time.
-    Cruise { v: f64, curvature: f64, until: f64 },
+    /// Stops early if the clearance falls below `floor` (m).
+    Cruise {
+        v: f64,
+        curvature: f64,
+        until: f64,
+        floor: f64,
+    },
     /// Drive straight (forward or backward) until the position along the fixed line
     /// reaches `target` (m).
     Straight { target: f64, speed: f64 },
@@ -136,6 +160,8 @@ enum Maneuver {
 const SPIN_TOLERANCE: f64 = 0.01;
 /// How close (m) pure pursuit has to get to its goal.
 const GOAL_TOLERANCE: f64 = 0.02;
+/// How long (s) the no-spins drive stands still before changing direction.
+const REVERSING_PAUSE: f64 = 1.0;
 /// Longest time (s) a manoeuvre may take before it is abandoned and re-planned.
 const MANEUVER_TIMEOUT: f64 = 40.0;
 
@@ -154,6 +180,8 @@ pub struct Planner {
     circle_curvature: f64,
     /// Where the mixed trajectory has been planning from.
     visits: VisitGrid,
+    /// For no-spins: whether the last run went backward.
+    backing: bool,
 }
 
 /// Counts of planning positions per 0.5 m cell.
@@ -195,7 +223,7 @@ impl Planner {
         let mut line = None;
         let mut circle_curvature = 1.0 / limits.turn_radius;
         let start = match kind {
-            TrajectoryKind::Mixed | TrajectoryKind::SpinOnly => {
+            TrajectoryKind::Mixed | TrajectoryKind::SpinOnly | TrajectoryKind::NoSpins => {
                 let p = free_point(world, home, limits.clearance + 0.1, &mut rng)?;
                 Pose2::new(
                     p[0],
@@ -225,6 +253,7 @@ impl Planner {
             line,
             circle_curvature,
             visits: VisitGrid::default(),
+            backing: false,
         };
         Ok((planner, start))
     }
@@ -290,7 +319,9 @@ impl Planner {
                 v,
                 curvature,
                 until,
-            } => (t < until).then(|| self.robot.wheel_speeds(v, v * curvature)),
+                floor,
+            } => (t < until && world.clearance([pose.x, pose.y]) >= floor)
+                .then(|| self.robot.wheel_speeds(v, v * curvature)),
             Maneuver::Straight { target, speed } => {
                 let (origin, dir, _) = self.line?;
                 let along = (pose.x - origin[0]) * dir[0] + (pose.y - origin[1]) * dir[1];
@@ -312,6 +343,7 @@ impl Planner {
         };
         match self.kind {
             TrajectoryKind::Mixed => self.plan_mixed(t, pose, world),
+            TrajectoryKind::NoSpins => self.plan_no_spins(t, pose, world),
             TrajectoryKind::SpinOnly => {
                 let angle = self.rng.random_range(0.3..3.5) * random_sign(&mut self.rng);
                 let rate = self.rng.random_range(0.3..=lim.max_turn_rate);
@@ -342,6 +374,7 @@ impl Planner {
                     v,
                     curvature,
                     until,
+                    floor: 0.0,
                 });
                 let p = pause(&mut self.rng, 0.1, 0.8);
                 self.queue.push_back(p);
@@ -422,6 +455,89 @@ impl Planner {
     }
 }
 
+impl Planner {
+    /// One run of the joystick drive ([`TrajectoryKind::NoSpins`]): among a few runs
+    /// (straight or arc, forward or now and then backward) that keep the clearance,
+    /// the one ending in the least visited place; backward runs too when no forward
+    /// one is free; the freest run tried when none keeps the full clearance.
+    fn plan_no_spins(&mut self, t: f64, pose: &Pose2, world: &World) {
+        let lim = self.limits;
+        let here = [pose.x, pose.y];
+        if self.rng.random_bool(0.06) {
+            let until = t + self.rng.random_range(0.3..1.5);
+            self.queue.push_back(Maneuver::Pause { until });
+            return;
+        }
+        let needed = lim.clearance.min(world.clearance(here) - 0.01).max(0.05);
+        let floor = 0.66 * needed;
+        self.visits.record(here);
+        let max_curvature = 1.0 / lim.turn_radius;
+        // Runs as (v, curvature, until).
+        let mut best: Option<(u32, (f64, f64, f64))> = None;
+        let mut freest: Option<(f64, (f64, f64, f64))> = None;
+        let mut found = 0;
+        for attempt in 0..400 {
+            let backward = attempt >= 200 || self.rng.random_bool(0.08);
+            let curvature = if self.rng.random_bool(0.3) {
+                0.0
+            } else {
+                self.rng.random_range(0.05..=max_curvature) * random_sign(&mut self.rng)
+            };
+            let speed = self
+                .rng
+                .random_range(0.15 * lim.max_speed..=lim.max_speed)
+                .min(lim.max_turn_rate / curvature.abs().max(1e-9));
+            let duration = self.rng.random_range(1.0..4.0);
+            let v = if backward { -speed } else { speed };
+            // Checked half a second further: the motors' lag carries the robot on.
+            let clearance = path_clearance_along(world, pose, v * (duration + 0.5), curvature);
+            let run = (v, curvature, t + duration);
+            if freest.is_none_or(|f| clearance > f.0) {
+                freest = Some((clearance, run));
+            }
+            if clearance < needed {
+                continue;
+            }
+            let end = pose.compose(&arc_motion(v * duration, v * duration * curvature, 1.0));
+            let visits = self.visits.count([end.x, end.y]);
+            if best.is_none_or(|b| visits < b.0) {
+                best = Some((visits, run));
+            }
+            found += 1;
+            if found == 6 {
+                break;
+            }
+        }
+        let cruise = |(v, curvature, until): (f64, f64, f64), floor: f64| Maneuver::Cruise {
+            v,
+            curvature,
+            until,
+            floor,
+        };
+        let (run, floor) = match (best, freest) {
+            (Some((_, run)), _) => (run, floor),
+            (None, Some((clearance, run))) if clearance > 0.05 => (run, 0.0),
+            _ => {
+                self.queue.push_back(Maneuver::Pause { until: t + 0.5 });
+                return;
+            }
+        };
+        let (v, curvature, until) = run;
+        if (v < 0.0) != self.backing {
+            // Stop before changing direction, as a driver does: both wheels slow down
+            // together, so the robot never pivots on the way through zero speed.
+            self.queue.push_back(Maneuver::Pause {
+                until: t + REVERSING_PAUSE,
+            });
+            self.backing = v < 0.0;
+            self.queue
+                .push_back(cruise((v, curvature, until + REVERSING_PAUSE), floor));
+        } else {
+            self.queue.push_back(cruise(run, floor));
+        }
+    }
+}
+
 /// The smallest clearance along the circular arc, tangent to the robot's heading,
 /// from the robot to the goal at `local` (robot frame).
 fn arc_clearance(world: &World, pose: &Pose2, local: [f64; 2]) -> f64 {
@@ -430,7 +546,13 @@ fn arc_clearance(world: &World, pose: &Pose2, local: [f64; 2]) -> f64 {
     let curvature = 2.0 * local[1] / d2;
     let bearing = local[1].atan2(local[0]);
     let length = d / sin_over_x(bearing);
-    let n = (length / 0.05).ceil().max(1.0) as usize;
+    path_clearance_along(world, pose, length, curvature)
+}
+
+/// The smallest clearance along the arc of signed `length` (m; negative: backward)
+/// and `curvature` (1/m) from `pose`, tangent to its heading.
+fn path_clearance_along(world: &World, pose: &Pose2, length: f64, curvature: f64) -> f64 {
+    let n = (length.abs() / 0.05).ceil().max(1.0) as usize;
     let mut prev = [pose.x, pose.y];
     let mut worst = f64::INFINITY;
     for i in 1..=n {

@@ -47,9 +47,10 @@ pub struct SimEncoderRecord {
     /// Cumulative counts `[left, right]`, unwrapped (the log shows them modulo
     /// `encoder.modulus` when set).
     pub ticks: [i64; 2],
-    /// True cumulative wheel rotations `[left, right]` (rad) at `t`.
+    /// True cumulative wheel rotations `[left, right]` (rad) when the counts were read
+    /// (at `t`, except for records stored with the scans and read with jitter).
     pub wheel_angles: [f64; 2],
-    /// True robot pose at `t`.
+    /// True robot pose when the counts were read.
     pub robot: Pose2,
     /// Left out of the log by the drop fault.
     pub dropped: bool,
@@ -136,7 +137,7 @@ pub fn simulate_in(config: &SimConfig, world: &World) -> Result<SimRun, SimError
         world.home(),
         rng_for(c.seed, Stream::Planner),
     )?;
-    let encoder_times = sample_times(
+    let mut encoder_times = sample_times(
         c.encoder.rate_hz,
         c.encoder.jitter_s,
         0,
@@ -153,6 +154,30 @@ pub fn simulate_in(config: &SimConfig, world: &World) -> Result<SimRun, SimError
         duration_us,
         &mut laser_timing,
     );
+    // When each record's counts are read, and the timestamp it is written with.
+    let mut encoder_stamps = encoder_times.clone();
+    if c.encoder.with_scans {
+        // Stamped with the scan's timestamp (laser clock), read when the encoder clock
+        // shows it, give or take the encoder jitter (not in the stamp).
+        let jitter = (c.encoder.jitter_s * 1e6).round() as i64;
+        let mut rng = rng_for(c.seed, Stream::EncoderTiming);
+        encoder_times.clear();
+        encoder_stamps.clear();
+        for &t in &scan_times {
+            let j = if jitter > 0 {
+                rng.random_range(-jitter..=jitter)
+            } else {
+                0
+            };
+            let stamp = t as i64 + offset_us;
+            let read = stamp + j;
+            let after_last = encoder_times.last().is_none_or(|&l| read > l as i64);
+            if stamp >= 0 && read >= 0 && read as u64 <= duration_us && after_last {
+                encoder_times.push(read as u64);
+                encoder_stamps.push(stamp as u64);
+            }
+        }
+    }
     let slips = c.faults.slip_episodes(
         c.duration,
         substep_us as f64 * 1e-6,
@@ -203,7 +228,7 @@ pub fn simulate_in(config: &SimConfig, world: &World) -> Result<SimRun, SimError
         while ei < encoder_times.len() && encoder_times[ei] < t1 {
             let s = drive.state_at_us(encoder_times[ei]);
             encoders.push(SimEncoderRecord {
-                t: timestamp(start_us + encoder_times[ei] as i64),
+                t: timestamp(start_us + encoder_stamps[ei] as i64),
                 ticks: c.encoder.ticks(s.wheel_angles),
                 wheel_angles: s.wheel_angles,
                 robot: s.pose,

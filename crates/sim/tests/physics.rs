@@ -289,3 +289,80 @@ fn fast_robots_stay_off_the_walls_and_drive_fast() {
         assert!(top > fastest, "{preset}: top speed {top} m/s");
     }
 }
+
+#[test]
+fn no_spins_drives_straights_and_arcs_but_never_spins() {
+    for seed in [19, 20] {
+        let r = run("pioneer", seed, 120.0, |c| {
+            c.laser.num_rays = 3;
+            c.trajectory = TrajectoryKind::NoSpins;
+            c.motion.max_speed = 0.6;
+        });
+        let radius = r.config.motion.turn_radius;
+        let (mut straights, mut arcs, mut tight, mut moving) = (0, 0, 0, 0);
+        let mut travelled = 0.0;
+        for d in interval_motions(&r) {
+            let dist = d.translation_norm();
+            let turn = d.theta.abs();
+            travelled += dist;
+            if dist < 1e-4 && turn < 1e-4 {
+                continue;
+            }
+            moving += 1;
+            // Never a spin in place (as defined for the mixed trajectory) ...
+            assert!(
+                !(dist < 1e-3 && turn > 0.02),
+                "seed {seed}: turned {turn} rad over {dist} m"
+            );
+            // ... and rarely a circle tighter than the smallest radius (only when the
+            // motors' lag blends a forward and a backward run).
+            if turn > 1e-4 && dist / turn < 0.95 * radius {
+                tight += 1;
+            }
+            if turn < 1e-3 {
+                straights += 1;
+            } else if turn > 0.01 {
+                arcs += 1;
+            }
+        }
+        assert!(
+            straights * 10 > moving,
+            "seed {seed}: {straights} straight of {moving}"
+        );
+        assert!(arcs * 5 > moving, "seed {seed}: {arcs} arcs of {moving}");
+        assert!(
+            tight * 50 < moving,
+            "seed {seed}: {tight} tight turns of {moving}"
+        );
+        assert!(travelled > 30.0, "seed {seed}: only {travelled} m in 120 s");
+        let worst = closest_wall(&r);
+        assert!(worst > 0.19, "seed {seed}: came within {worst} m of a wall");
+    }
+}
+
+#[test]
+fn encoders_stored_with_each_scan_carry_its_timestamp() {
+    let r = run("pioneer", 21, 20.0, |c| {
+        c.laser.num_rays = 3;
+        c.encoder.with_scans = true;
+        c.faults.clock_offset = 0.15;
+    });
+    let stamps: Vec<f64> = r.logged_scans().map(|s| s.t).collect();
+    let records: Vec<_> = r.logged_encoders().collect();
+    // The first 0.15 s of scans have no counts (read before the start).
+    assert!(records.len() + 3 >= stamps.len() && records.len() < stamps.len());
+    for e in &records {
+        assert!(stamps.iter().any(|t| (t - e.t).abs() < 1e-9), "{}", e.t);
+    }
+    // One record per scan period (0.1 s at up to 0.5 m/s), in order.
+    for w in records.windows(2) {
+        assert!(
+            (w[1].t - w[0].t - 0.1).abs() < 0.01,
+            "{} {}",
+            w[0].t,
+            w[1].t
+        );
+        let moved = w[0].robot.between(&w[1].robot).translation_norm();
+        assert!(moved < 0.06, "{moved}");
+    }
+}
