@@ -2,14 +2,15 @@
 //! library from simulated runs, see make_bags.py): each calibrates back to its ground
 //! truth within the bounds of the Carmen logs (0.35 % for r_L, r_R, b; 1.5 mm; 0.2°;
 //! 4σ) — ROS 1 lz4 / bz2 / uncompressed with a clockwise laser, MCAP, db3 with
-//! velocity-only joint states, a ROS 2 bag directory, and odometry only. Plus bad input:
+//! velocity-only joint states, a ROS 2 bag directory, odometry only, and wheel positions
+//! wrapped to (−π, π] (unwrapped, with a note). Plus bad input:
 //! each a clear error naming the file and what to do.
 
 mod common;
 
 use odocal_bag::{read_bag, BagOptions, TopicChoice};
 use odocal_log::{encoders_from_odometry, NominalWheels, ValueSource, WHEEL_TICKS_PER_REVOLUTION};
-use odocal_pipeline::{calibrate_log, NoProgress, Options};
+use odocal_pipeline::{calibrate_log, FindingKind, NoProgress, Options, Severity};
 use odocal_report::build_report;
 use std::path::{Path, PathBuf};
 
@@ -32,7 +33,7 @@ fn truth(name: &str) -> (Vec<f64>, Vec<f64>) {
     (get("params"), get("nominal"))
 }
 
-fn check(name: &str) {
+fn check(name: &str) -> odocal_report::Report {
     let path = fixture(name);
     let (truth, nominal) = truth(name);
     let bag = read_bag(&path, &BagOptions::default()).expect("the fixture bag reads");
@@ -78,6 +79,7 @@ fn check(name: &str) {
         report.samples_used
     );
     assert!(failures.is_empty(), "{name}: {}", failures.join("; "));
+    report
 }
 
 #[test]
@@ -118,6 +120,38 @@ fn pioneer_sick_181_rays_clockwise_ros1_bz2_calibrates() {
 #[test]
 fn ros2_bag_directory_calibrates() {
     check("khepera_ros2_dir");
+}
+
+#[test]
+fn wheel_positions_wrapped_to_half_a_turn_calibrate_with_a_note() {
+    let name = "khepera_ros1_wrapped.bag";
+    // The fixture's wheel angles are wrapped: within ±π, with jumps of about 2π.
+    let log = read_bag(&fixture(name), &BagOptions::default())
+        .unwrap()
+        .log;
+    let half = WHEEL_TICKS_PER_REVOLUTION as i64 / 2;
+    assert!(log
+        .encoders
+        .iter()
+        .all(|e| e.left.abs() <= half && e.right.abs() <= half));
+    let jumps: usize = log
+        .encoders
+        .windows(2)
+        .map(|w| {
+            usize::from((w[1].left - w[0].left).abs() > half)
+                + usize::from((w[1].right - w[0].right).abs() > half)
+        })
+        .sum();
+    assert!(jumps >= 10, "{jumps} wraps in the fixture");
+    let report = check(name);
+    let notes: Vec<_> = report
+        .health
+        .iter()
+        .filter(|f| f.kind == FindingKind::WheelAngleWrap)
+        .collect();
+    assert_eq!(notes.len(), 1, "{:?}", report.health);
+    assert_eq!(notes[0].severity, Severity::Info, "{}", notes[0]);
+    assert_eq!(notes[0].count, jumps as u64, "{}", notes[0]);
 }
 
 /// A copy of a fixture, changed by `edit`, in a temporary file.

@@ -1,6 +1,9 @@
 //! The command line on bags: `info --json` carries the topics and the same keys as for
-//! logs; odometry-only mode without `--nominal` is refused with the flag to give; bag
-//! flags on a Carmen log are refused.
+//! logs; odometry-only mode without `--nominal` is refused with the flag to give, by
+//! `calibrate` and by `match`, and with it `match` writes samples that `solve`
+//! calibrates; bag flags on a Carmen log are refused.
+
+mod common;
 
 use std::process::Command;
 
@@ -40,6 +43,59 @@ fn odometry_only_needs_the_nominal_parameters() {
         err.contains("--nominal r_L,r_R,b") && err.contains("khepera_ros1_bz2_odom.bag"),
         "{err}"
     );
+}
+
+#[test]
+fn match_takes_the_nominal_parameters_of_odometry_only_input() {
+    let bag = "fixtures/bags/khepera_ros1_bz2_odom.bag";
+    let dir = common::temp_dir("match-nominal");
+    let tuples = dir.join("odom.tuple");
+    let tuples = tuples.to_str().unwrap();
+    let out = odocal(&["match", bag, "--out", tuples]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--nominal r_L,r_R,b") && err.contains(bag),
+        "{err}"
+    );
+
+    let out = odocal(&[
+        "match",
+        bag,
+        "--out",
+        tuples,
+        "--nominal",
+        "0.021,0.021,0.0884",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("odometry-only mode"), "{err}");
+    let out = odocal(&["solve", tuples, "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let truth_json = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("fixtures/bags/khepera_ros1_bz2_odom.truth.json"),
+    )
+    .unwrap();
+    let truth: odocal_geom::FlatParams = serde_json::from_value(
+        serde_json::from_str::<serde_json::Value>(&truth_json).unwrap()["params"].clone(),
+    )
+    .unwrap();
+    let truth = truth.to_array();
+    let bounds = common::bounds(&truth);
+    for (i, name) in ["r_l", "r_r", "b", "l_x", "l_y", "l_theta"]
+        .iter()
+        .enumerate()
+    {
+        let err = v[name].as_f64().unwrap() - truth[i];
+        assert!(err.abs() < bounds[i], "{name}: error {err:.3e}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

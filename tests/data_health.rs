@@ -6,7 +6,7 @@
 mod common;
 
 use odocal_log::{read_carmen_from, Log, ReadOptions};
-use odocal_pipeline::{calibrate_log, FaultKind, NoProgress, Options, Outcome, PipelineError};
+use odocal_pipeline::{calibrate_log, FindingKind, NoProgress, Options, Outcome, PipelineError};
 use odocal_sim::{simulate, SimConfig};
 
 /// r_L, r_R, b, ℓx, ℓy, ℓθ.
@@ -23,10 +23,7 @@ fn sim_lines(duration: f64, seed: u64, tweak: impl FnOnce(&mut SimConfig)) -> (V
     let summary = run.write_log(&mut bytes, &[]).expect("log written");
     let p = run.ground_truth(&summary).params;
     let text = String::from_utf8(bytes).expect("text");
-    (
-        text.lines().map(String::from).collect(),
-        [p.r_l, p.r_r, p.b, p.l_x, p.l_y, p.l_theta],
-    )
+    (text.lines().map(String::from).collect(), p.to_array())
 }
 
 fn read(lines: &[String]) -> Log {
@@ -61,7 +58,7 @@ fn with_timestamp(line: &str, t: f64) -> String {
     tok.join(" ")
 }
 
-fn finding(o: &Outcome, kind: FaultKind) -> &odocal_pipeline::Finding {
+fn finding(o: &Outcome, kind: FindingKind) -> &odocal_pipeline::Finding {
     o.health
         .iter()
         .find(|f| f.kind == kind)
@@ -124,7 +121,7 @@ fn colliding_and_rounded_encoder_timestamps_are_merged() {
     let t = timestamp(&lines[k]);
     lines[next] = with_timestamp(&lines[next], t);
     let o = run(&read(&lines), &Options::default()).expect("one collision calibrates");
-    let f = finding(&o, FaultKind::TimestampCollision);
+    let f = finding(&o, FindingKind::TimestampCollision);
     assert_eq!((f.count, f.first_line), (1, Some(next as u64 + 1)));
     assert_within("one collision", &o, &truth, 1.0, 4.0);
     // … and every ENCODER timestamp rounded to 0.1 s.
@@ -132,7 +129,7 @@ fn colliding_and_rounded_encoder_timestamps_are_merged() {
         *l = with_timestamp(l, (timestamp(l) * 10.0).round() / 10.0);
     }
     let o = run(&read(&lines), &Options::default()).expect("rounded timestamps calibrate");
-    let f = finding(&o, FaultKind::TimestampCollision);
+    let f = finding(&o, FindingKind::TimestampCollision);
     assert!(f.count > 1000 && f.message.contains("0.100 s"), "{f:?}");
     // The encoder timing is blurred to 0.1 s: twice the bounds.
     assert_within("rounded", &o, &truth, 2.0, 4.0);
@@ -146,7 +143,7 @@ fn wrapping_counters_without_the_param_are_unwrapped() {
         .filter(|l| !l.starts_with("PARAM robot_encoder_modulus"))
         .collect();
     let o = run(&read(&lines), &Options::default()).expect("calibrates");
-    let f = finding(&o, FaultKind::EncoderWrap);
+    let f = finding(&o, FindingKind::EncoderWrap);
     assert!(
         f.count > 0 && f.message.contains("--encoder-modulus 65536"),
         "{f:?}"
@@ -165,7 +162,7 @@ fn a_laser_clock_jumping_back_keeps_the_longest_stretch() {
         lines[i] = with_timestamp(&lines[i], timestamp(&lines[i]) - 10.0);
     }
     let o = run(&read(&lines), &Options::default()).expect("calibrates");
-    let f = finding(&o, FaultKind::ClockJump);
+    let f = finding(&o, FindingKind::ClockJump);
     assert_eq!(f.first_line, Some(jump_at as u64 + 1));
     assert!(f.message.contains("back 10.0"), "{}", f.message);
     assert_within("clock jump", &o, &truth, 1.5, 4.0);
@@ -183,7 +180,7 @@ fn a_frozen_scan_is_left_out() {
         lines[i] = with_timestamp(&frozen, timestamp(&lines[i]));
     }
     let o = run(&read(&lines), &Options::default()).expect("calibrates");
-    let f = finding(&o, FaultKind::FrozenScan);
+    let f = finding(&o, FindingKind::FrozenScan);
     assert_eq!((f.count, f.first_line), (50, Some(scans[201] as u64 + 1)));
     assert_within("frozen", &o, &truth, 1.0, 4.0);
 }
@@ -219,7 +216,7 @@ fn duplicated_scan_lines_are_dropped() {
         })
         .collect();
     let o = run(&read(&doubled), &Options::default()).expect("calibrates");
-    let f = finding(&o, FaultKind::Duplicate);
+    let f = finding(&o, FindingKind::Duplicate);
     assert_eq!(f.count as usize, read(&lines).scans.len());
     // The same samples, the same numbers and σ's as the clean log.
     assert_eq!(o.synced.samples.len(), clean.synced.samples.len());
@@ -242,7 +239,7 @@ fn encoder_spikes_are_dropped() {
     lines[enc[700]] = edit(&lines[enc[700]], &(l0 + 1_000_000_000_000).to_string());
     lines[enc[1500]] = edit(&lines[enc[1500]], &i64::MAX.to_string());
     let o = run(&read(&lines), &Options::default()).expect("calibrates");
-    let f = finding(&o, FaultKind::EncoderSpike);
+    let f = finding(&o, FindingKind::EncoderSpike);
     assert_eq!((f.count, f.first_line), (2, Some(enc[700] as u64 + 1)));
     assert_within("spikes", &o, &truth, 1.0, 4.0);
 }
@@ -260,7 +257,7 @@ fn a_large_clock_offset_is_flagged_and_estimated_first() {
         },
     );
     let text = match &o {
-        Ok(o) => finding(o, FaultKind::ClockOffset).message.clone(),
+        Ok(o) => finding(o, FindingKind::ClockOffset).message.clone(),
         Err(e) => e.to_string(),
     };
     println!("{text}");
@@ -277,7 +274,7 @@ fn a_large_clock_offset_is_flagged_and_estimated_first() {
     let est = o.offset.as_ref().unwrap().offset;
     assert!((est - 0.3).abs() < 0.005, "estimated {est}");
     assert!(
-        o.health.iter().all(|f| f.kind != FaultKind::ClockOffset),
+        o.health.iter().all(|f| f.kind != FindingKind::ClockOffset),
         "{:#?}",
         o.health
     );
@@ -293,7 +290,7 @@ fn an_offset_beyond_the_search_range_is_an_edge_warning() {
         ..Options::default()
     };
     let text = match run(&read(&lines), &opts) {
-        Ok(o) => finding(&o, FaultKind::ClockOffset).message.clone(),
+        Ok(o) => finding(&o, FindingKind::ClockOffset).message.clone(),
         Err(e) => e.to_string(),
     };
     assert!(

@@ -17,7 +17,7 @@ use common::accuracy::NAMES;
 use common::{cleanup, simulated_log, Truth};
 use odocal_log::{read_log, ReadOptions};
 use odocal_pipeline::sync::DiscardReason;
-use odocal_pipeline::{calibrate_log, FaultKind, NoProgress, Options, Outcome, PipelineError};
+use odocal_pipeline::{calibrate_log, FindingKind, NoProgress, Options, Outcome, PipelineError};
 use odocal_sim::TrajectoryKind;
 use odocal_solver::Verdict;
 use std::path::{Path, PathBuf};
@@ -142,7 +142,7 @@ fn check_pair(seeds: (u64, u64), turn_radius: f64) {
             assert!(text.contains("--estimate-time-offset"), "{label}: {text}");
         }
         Ok(o) => assert!(
-            o.health.iter().any(|f| f.kind == FaultKind::ClockOffset
+            o.health.iter().any(|f| f.kind == FindingKind::ClockOffset
                 && f.message.contains("--estimate-time-offset")),
             "{label}: numbers without the clock-offset warning"
         ),

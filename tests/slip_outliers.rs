@@ -34,7 +34,7 @@ fn slip_run(
         .build()
         .expect("pool")
         .install(|| calibrate_log(&log, &opts, &NoProgress));
-    (out, [p.r_l, p.r_r, p.b, p.l_x, p.l_y, p.l_theta])
+    (out, p.to_array())
 }
 
 /// (worst error / bound, worst |error| / σ) over the six parameters.

@@ -1,13 +1,12 @@
 //! `odocal calibrate LOG`: raw log in, calibrated robot out.
 
 use crate::input::InputArgs;
+use crate::nominal::{describe, odometry_only_mode};
 use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
-use odocal_log::{encoders_from_odometry, NominalWheels, ValueSource, WHEEL_TICKS_PER_REVOLUTION};
 use odocal_pipeline::{calibrate_log, Options, Trim};
 use odocal_report::{build_report, sha256_of_file, write_html, write_outputs, Provenance};
-use odocal_solver::Params;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -73,16 +72,6 @@ pub struct Args {
     /// Half-width (s) of the clock-offset search; implies --estimate-time-offset.
     #[arg(long, value_name = "S")]
     pub time_offset_range: Option<f64>,
-    /// Nominal parameters "r_L,r_R,b" or "r_L,r_R,b,l_x,l_y,l_theta" (m, rad): first
-    /// guesses for scan matching come from odometry with them, and the figures
-    /// compare them with the calibrated ones.
-    #[arg(
-        long,
-        value_name = "LIST",
-        value_delimiter = ',',
-        allow_negative_numbers = true
-    )]
-    pub nominal: Option<Vec<f64>>,
     /// Identity first guesses for every scan pair (default: odometry with a rough
     /// estimate from 300 evenly spread pairs, when the log has at least 600).
     #[arg(long)]
@@ -106,54 +95,6 @@ pub struct Args {
     pub json: bool,
 }
 
-/// Parameters from `--nominal`: three values (r_L, r_R, b; laser at the origin) or six.
-fn nominal_params(v: &[f64]) -> anyhow::Result<Params> {
-    let full = match v.len() {
-        3 => [v[0], v[1], v[2], 0.0, 0.0, 0.0],
-        6 => [v[0], v[1], v[2], v[3], v[4], v[5]],
-        n => anyhow::bail!(
-            "--nominal takes 3 values (r_L,r_R,b) or 6 (r_L,r_R,b,l_x,l_y,l_theta), got {n}"
-        ),
-    };
-    if !(full.iter().all(|x| x.is_finite()) && full[..3].iter().all(|x| *x > 0.0)) {
-        anyhow::bail!("--nominal needs positive radii and wheel distance and finite values");
-    }
-    Ok(Params::from_vector(full))
-}
-
-/// Odometry-only mode: a log (or bag) with odometry poses but no wheel encoders. The
-/// poses were integrated with nominal parameters; each interval's wheel rotations are
-/// recovered from the pose increments with them (`--nominal`, required here) and become
-/// the log's encoder records. Returns the nominal wheels when the mode applies.
-fn odometry_only_mode(
-    file: &std::path::Path,
-    log: &mut odocal_log::Log,
-    nominal: Option<&Params>,
-) -> anyhow::Result<Option<NominalWheels>> {
-    if !log.encoders.is_empty() || log.odom.is_empty() {
-        return Ok(None);
-    }
-    let Some(p) = nominal else {
-        anyhow::bail!(
-            "{}: odometry-only mode (odometry poses, no wheel encoders): the wheel rotations \
-             are recovered from the poses with the parameters the robot integrated them \
-             with; give them with --nominal r_L,r_R,b (metres)",
-            file.display()
-        );
-    };
-    let wheels = NominalWheels {
-        r_l: p.r_l,
-        r_r: p.r_r,
-        b: p.b,
-    };
-    let Some(encoders) = encoders_from_odometry(&log.odom, wheels) else {
-        anyhow::bail!("{}: an odometry pose is not finite", file.display());
-    };
-    log.encoders = encoders;
-    log.params.ticks_per_revolution = Some((WHEEL_TICKS_PER_REVOLUTION, ValueSource::Convention));
-    Ok(Some(wheels))
-}
-
 /// Runs `odocal calibrate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
@@ -163,7 +104,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut log = input.read_log()?;
     let parse_s = t_parse.elapsed().as_secs_f64();
 
-    let initial_params = args.nominal.as_deref().map(nominal_params).transpose()?;
+    let initial_params = input.nominal()?;
     let odometry_only = odometry_only_mode(&input.read.log, &mut log, initial_params.as_ref())?;
     let mut opts = Options {
         initial_params,
@@ -214,9 +155,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 serde_json::json!({
                     "nominal": {"r_l": nominal.r_l, "r_r": nominal.r_r, "b": nominal.b},
                     "correction_factors": {
-                        "r_l": report.r_l / nominal.r_l,
-                        "r_r": report.r_r / nominal.r_r,
-                        "b": report.b / nominal.b,
+                        "r_l": report.params.r_l / nominal.r_l,
+                        "r_r": report.params.r_r / nominal.r_r,
+                        "b": report.params.b / nominal.b,
                     },
                 }),
             );
@@ -226,15 +167,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         print!("{report}");
         if let Some(n) = &odometry_only {
             println!(
-                "odometry-only mode: wheel rotations recovered from the odometry poses with the \
-                 nominal r_L = {} m, r_R = {} m, b = {} m\ncorrection factors of the nominal: \
-                 r_L x{:.5}, r_R x{:.5}, b x{:.5}",
-                n.r_l,
-                n.r_r,
-                n.b,
-                report.r_l / n.r_l,
-                report.r_r / n.r_r,
-                report.b / n.b
+                "{}\ncorrection factors of the nominal: r_L x{:.5}, r_R x{:.5}, b x{:.5}",
+                describe(n),
+                report.params.r_l / n.r_l,
+                report.params.r_r / n.r_r,
+                report.params.b / n.b
             );
         }
     }

@@ -1,9 +1,11 @@
-//! The arguments `calibrate` and `match` share: the log and how to read it, how to
-//! pair its scans, and how many threads match them.
+//! The arguments `calibrate` and `match` share: the log and how to read it, the
+//! robot's nominal parameters, how to pair its scans, and how many threads match them.
 
+use crate::nominal::nominal_params;
 use crate::read_args::ReadArgs;
 use anyhow::Context;
 use odocal_log::Log;
+use odocal_solver::Params;
 
 /// The input log and the options of reading, pairing and matching it.
 #[derive(clap::Args, Debug)]
@@ -25,12 +27,28 @@ pub struct InputArgs {
     /// Threads for scan matching (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
+    /// Nominal parameters "r_L,r_R,b" or "r_L,r_R,b,l_x,l_y,l_theta" (m, rad): first
+    /// guesses for scan matching come from odometry with them; odometry-only inputs
+    /// (odometry poses, no wheel encoders) need them to recover the wheel rotations;
+    /// calibrate's figures compare them with the calibrated ones.
+    #[arg(
+        long,
+        value_name = "LIST",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    pub nominal: Option<Vec<f64>>,
 }
 
 impl InputArgs {
     /// A rayon pool with `--threads` threads (all cores when not given).
     pub fn thread_pool(&self) -> anyhow::Result<rayon::ThreadPool> {
         thread_pool(self.threads)
+    }
+
+    /// The parameters given with `--nominal`, checked.
+    pub fn nominal(&self) -> anyhow::Result<Option<Params>> {
+        self.nominal.as_deref().map(nominal_params).transpose()
     }
 
     /// Reads the log with the reading options of [`ReadArgs`].

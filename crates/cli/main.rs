@@ -12,6 +12,7 @@ mod calibrate;
 mod info;
 mod input;
 mod matching;
+mod nominal;
 mod partial_args;
 mod progress_bar;
 mod read_args;

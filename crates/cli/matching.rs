@@ -2,6 +2,7 @@
 //! samples as tuples (one JSON object per line).
 
 use crate::input::InputArgs;
+use crate::nominal::{describe, odometry_only_mode};
 use crate::progress_bar::Bar;
 use anyhow::Context;
 use odocal_pipeline::{health, synchronize_and_match, write_tuples, Options, Timing};
@@ -21,8 +22,13 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let input = &args.input;
     let pool = input.thread_pool()?;
-    let log = input.read_log()?;
+    let mut log = input.read_log()?;
+    let initial_params = input.nominal()?;
+    if let Some(n) = odometry_only_mode(&input.read.log, &mut log, initial_params.as_ref())? {
+        eprintln!("{}", describe(&n));
+    }
     let opts = Options {
+        initial_params,
         ticks_per_revolution: input.read.ticks_per_rev,
         stride: input.stride,
         time_offset: input.time_offset,

@@ -6,7 +6,7 @@
 use crate::calibrate::TrimArg;
 use crate::partial_args::PartialArgs;
 use anyhow::Context;
-use odocal_geom::Pose2;
+use odocal_geom::{FlatParams, Pose2};
 use odocal_log::{read_tuples, TupleRecord};
 use odocal_solver::{
     calibrate, Calibration, Constraint, Constraints, ProfileSegment, Sample, SigmaEstimate,
@@ -77,12 +77,8 @@ pub fn sample_from_record(rec: &TupleRecord) -> Sample {
 /// The JSON printed by `--json`.
 #[derive(Serialize)]
 struct JsonOutput<'a> {
-    r_l: f64,
-    r_r: f64,
-    b: f64,
-    l_x: f64,
-    l_y: f64,
-    l_theta: f64,
+    #[serde(flatten)]
+    params: FlatParams,
     covariance: [[f64; 6]; 6],
     j: [[f64; 2]; 2],
     samples_used: usize,
@@ -130,14 +126,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let cal = calibrate(&samples, &options)
         .with_context(|| format!("{}: calibration failed", args.tuples.display()))?;
     if args.json {
-        let p = &cal.params;
         let out = JsonOutput {
-            r_l: p.r_l,
-            r_r: p.r_r,
-            b: p.b,
-            l_x: p.laser.x,
-            l_y: p.laser.y,
-            l_theta: p.laser.theta,
+            params: cal.params.into(),
             covariance: cal.covariance,
             j: cal.j,
             samples_used: cal.samples_used,

@@ -54,7 +54,7 @@ pub fn simulated_log(
         .write_log(BufWriter::new(file), &[])
         .expect("write the log");
     let p = run.ground_truth(&summary).params;
-    (path, [p.r_l, p.r_r, p.b, p.l_x, p.l_y, p.l_theta])
+    (path, p.to_array())
 }
 
 /// Removes a test's directory (best effort).

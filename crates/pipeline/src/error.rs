@@ -62,7 +62,7 @@ pub enum PipelineError {
 impl PipelineError {
     /// Names the data faults found in front of a refusal (not enough samples, not
     /// determined, the solver's refusals) when there are any; other errors unchanged.
-    pub fn with_faults(self, findings: &[crate::health::Finding]) -> Self {
+    pub fn with_faults(self, findings: &[crate::finding::Finding]) -> Self {
         let refusal = matches!(
             self,
             PipelineError::TooFewSamples { .. }
@@ -70,7 +70,7 @@ impl PipelineError {
                 | PipelineError::Solve(_)
                 | PipelineError::Log(LogError::MissingData { .. })
         );
-        let Some(faults) = crate::health::explain(findings).filter(|_| refusal) else {
+        let Some(faults) = crate::finding::explain(findings).filter(|_| refusal) else {
             return self;
         };
         let cause = match &self {

@@ -16,7 +16,8 @@
 //! encoder profile, discards by reason), [`sweep`] (rays of a sweeping laser moved to
 //! the sensor frame at the scan's reference time), [`matching`] (ICP over the pairs, in
 //! parallel with [`parallel`]), [`health`] (data faults found, repaired and named,
-//! before and after matching), [`time_offset`] (optional clock-offset search), [`run`] (the
+//! before and after matching, as [`finding`]s: what the results want a reader to
+//! notice), [`time_offset`] (optional clock-offset search), [`run`] (the
 //! whole, with timing), [`samples`] (the samples and their tuples), [`estimate`] (the
 //! core numbers of a result).
 
@@ -26,6 +27,7 @@ pub mod atomic_file;
 pub mod consistency;
 mod error;
 pub mod estimate;
+pub mod finding;
 pub mod health;
 pub mod matching;
 pub mod parallel;
@@ -41,7 +43,7 @@ pub mod time_offset;
 pub use atomic_file::{write_atomically, write_bytes_atomically};
 pub use error::PipelineError;
 pub use estimate::Estimate;
-pub use health::{FaultKind, Finding, Severity};
+pub use finding::{Finding, FindingKind, Severity};
 pub use odocal_solver::Trim;
 pub use progress::{NoProgress, Progress};
 pub use run::{calibrate_log, synchronize_and_match, Options, Outcome, Synchronized, Timing};

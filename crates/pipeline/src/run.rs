@@ -2,7 +2,8 @@
 
 use crate::consistency::{check_halves, Consistency};
 use crate::error::PipelineError;
-use crate::health::{self, FaultKind, Finding, Severity};
+use crate::finding::{Finding, FindingKind};
+use crate::health;
 use crate::matching::{match_pairs, MatchStats};
 use crate::progress::Progress;
 use crate::samples::PairSample;
@@ -581,16 +582,12 @@ fn edge_warning(
         ),
         None => String::new(),
     };
-    Some(Finding {
-        kind: FaultKind::ClockOffset,
-        severity: Severity::Warning,
-        count: 1,
-        first_line: None,
-        time: None,
-        message: format!(
+    Some(Finding::warning(
+        FindingKind::ClockOffset,
+        format!(
             "the estimated clock offset {estimate:+.3} s lies at the edge of the search range \
              ({start:+.2} ± {range:.2} s): the true offset may lie beyond it{hint}; widen the \
              search with `--time-offset-range {wider}`"
         ),
-    })
+    ))
 }

@@ -56,7 +56,7 @@ use crate::error::PipelineError;
 use crate::estimate::Estimate;
 use crate::progress::NoProgress;
 use crate::run::{calibrate_log, Options};
-use odocal_geom::{wrap_angle, Pose2};
+use odocal_geom::{wrap_angle, FlatParams};
 use odocal_log::{read_carmen_from, read_tuples, ReadOptions};
 use odocal_solver::Params;
 use serde::{Deserialize, Serialize};
@@ -116,30 +116,6 @@ pub enum TableError {
     },
 }
 
-/// The six parameters under their printed headings, in metres and radians.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct PrintedParams {
-    /// Column "r_L" (m).
-    pub r_l: f64,
-    /// Column "r_R" (m).
-    pub r_r: f64,
-    /// Column "b" (m).
-    pub b: f64,
-    /// Column "ℓx" (m).
-    pub l_x: f64,
-    /// Column "ℓy" (m).
-    pub l_y: f64,
-    /// Column "ℓθ" (rad).
-    pub l_theta: f64,
-}
-
-impl PrintedParams {
-    /// The values in the order r_L, r_R, b, ℓx, ℓy, ℓθ.
-    pub fn to_array(&self) -> [f64; 6] {
-        [self.r_l, self.r_r, self.b, self.l_x, self.l_y, self.l_theta]
-    }
-}
-
 /// The printed J columns of a row (`J11`, `J12` may be missing).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct PrintedJ {
@@ -163,7 +139,7 @@ pub struct PublishedRow {
     /// Number of samples of the experiment.
     pub samples: u64,
     /// The parameters under their printed headings.
-    pub printed: PrintedParams,
+    pub printed: FlatParams,
     /// The printed J columns, when the table has them.
     pub j: Option<PrintedJ>,
     /// Published covariance (order r_L, r_R, b, ℓx, ℓy, ℓθ), when available.
@@ -185,7 +161,7 @@ impl PublishedRow {
             r_l,
             r_r,
             b: p.b,
-            laser: Pose2::new(p.l_x, p.l_y, p.l_theta),
+            laser: p.laser(),
         }
     }
 
@@ -234,11 +210,11 @@ impl PublishedRow {
 struct FileRow {
     name: String,
     samples: u64,
-    si: PrintedParams,
+    si: FlatParams,
     #[serde(flatten)]
     j: FileJ,
     #[serde(default)]
-    sigma: Option<PrintedParams>,
+    sigma: Option<FlatParams>,
 }
 
 /// Printed J columns of a file row (any may be missing).
@@ -497,7 +473,7 @@ pub fn read_tro_reference(dir: &Path) -> Result<Vec<PublishedRow>, TableError> {
             name: name.to_string(),
             source: format!("{description}; the package's published `{name}_results.json`"),
             samples,
-            printed: PrintedParams {
+            printed: FlatParams {
                 r_l: r.l_diam / 2.0,
                 r_r: r.r_diam / 2.0,
                 b: r.axle,
@@ -1112,6 +1088,7 @@ pub fn format_umbmark(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use odocal_geom::Pose2;
 
     // Made-up numbers throughout: these test the mechanisms, not a published table.
     const TABLE: &str = r#"{"citation": "made up", "rows": [

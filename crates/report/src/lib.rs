@@ -1,5 +1,5 @@
 //! The report of a calibration: the human summary and `results.json` ([`report`]),
-//! findings and checks other stages add to it ([`finding`]), where the run came from
+//! where the run came from
 //! ([`provenance`]), the figures ([`figures`], drawn with `plotters`), the one-page
 //! `results.html` ([`html`]) and the files `--out DIR` writes ([`output`]).
 //!
@@ -17,13 +17,12 @@
 #![deny(missing_docs)]
 
 pub mod figures;
-pub mod finding;
 pub mod html;
 pub mod output;
 pub mod provenance;
 pub mod report;
 
-pub use finding::{Finding, Severity};
+pub use odocal_pipeline::{Finding, FindingKind, Severity};
 pub use output::{html_report, write_html, write_outputs};
 pub use provenance::{sha256_of_file, Provenance};
 pub use report::{build_report, Report};

@@ -1,12 +1,12 @@
 //! The report of a calibration: what `--json` prints and `results.json` holds, and
 //! the human summary.
 
-use crate::finding::{Finding, Severity};
 use crate::provenance::Provenance;
+use odocal_geom::FlatParams;
 use odocal_log::Log;
 use odocal_pipeline::consistency::Consistency;
 use odocal_pipeline::sync::DiscardCounts;
-use odocal_pipeline::{Estimate, Options, Outcome, Timing};
+use odocal_pipeline::{Estimate, Finding, FindingKind, Options, Outcome, Timing};
 use odocal_solver::{Constraint, Observability, SharedScanNoise, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
@@ -20,19 +20,10 @@ pub struct Report {
     /// What the reader found in it.
     pub log_contents: LogContents,
     /// The data-health findings: each fault found, what was done, what the user can do.
-    pub health: Vec<odocal_pipeline::Finding>,
-    /// Left wheel radius (m).
-    pub r_l: f64,
-    /// Right wheel radius (m).
-    pub r_r: f64,
-    /// Wheel distance (m).
-    pub b: f64,
-    /// Laser x on the robot (m).
-    pub l_x: f64,
-    /// Laser y on the robot (m).
-    pub l_y: f64,
-    /// Laser heading on the robot (rad).
-    pub l_theta: f64,
+    pub health: Vec<Finding>,
+    /// The estimate: fields `r_l`, `r_r`, `b`, `l_x`, `l_y`, `l_theta` (m, rad).
+    #[serde(flatten)]
+    pub params: FlatParams,
     /// Standard deviations, order r_L, r_R, b, ℓx, ℓy, ℓθ.
     pub sigma: [f64; 6],
     /// Covariance 6×6, order r_L, r_R, b, ℓx, ℓy, ℓθ.
@@ -139,22 +130,15 @@ pub struct Settings {
 /// The two-halves check as a finding: a note when the halves agree or could not
 /// be checked, a warning when they disagree beyond 3σ.
 fn two_halves(c: &Consistency) -> Finding {
-    let (severity, message) = match c {
-        Consistency::Checked(h) if h.agree => (Severity::Info, h.sentence.clone()),
-        Consistency::Checked(h) => (Severity::Warning, h.sentence.clone()),
-        Consistency::NotAvailable { reason } => (
-            Severity::Info,
+    match c {
+        Consistency::Checked(h) if h.agree => {
+            Finding::note(FindingKind::TwoHalves, h.sentence.clone())
+        }
+        Consistency::Checked(h) => Finding::warning(FindingKind::TwoHalves, h.sentence.clone()),
+        Consistency::NotAvailable { reason } => Finding::note(
+            FindingKind::TwoHalves,
             format!("the two halves of the log were not compared: {reason}"),
         ),
-    };
-    Finding {
-        kind: "two_halves".into(),
-        severity,
-        count: 1,
-        first_line: None,
-        time: None,
-        spans: Vec::new(),
-        message,
     }
 }
 
@@ -173,12 +157,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             unknown_messages: log.stats.unknown.values().sum(),
         },
         health: outcome.health.clone(),
-        r_l: v[0],
-        r_r: v[1],
-        b: v[2],
-        l_x: v[3],
-        l_y: v[4],
-        l_theta: v[5],
+        params: FlatParams::from_array(v),
         sigma: e.sigma,
         covariance: e.covariance,
         j: e.j,
@@ -235,7 +214,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
 impl Report {
     /// The estimate as `[r_L, r_R, b, ℓx, ℓy, ℓθ]`.
     pub fn values(&self) -> [f64; 6] {
-        [self.r_l, self.r_r, self.b, self.l_x, self.l_y, self.l_theta]
+        self.params.to_array()
     }
 }
 

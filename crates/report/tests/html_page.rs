@@ -7,7 +7,7 @@ use odocal_log::{read_log, ReadOptions};
 use odocal_pipeline::{calibrate_log, NoProgress, Options, Outcome};
 use odocal_report::figures::figures;
 use odocal_report::html::page_with_results;
-use odocal_report::{build_report, Finding, Provenance, Report, Severity};
+use odocal_report::{build_report, Finding, FindingKind, Provenance, Report};
 use scraper::{Html, Selector};
 use serde_json::{json, Value};
 use std::path::PathBuf;
@@ -100,23 +100,18 @@ fn numbers_agree(doc: &Html, results: &Value) -> Vec<String> {
 fn page_has_every_section_and_figure_and_agrees_with_results_json() {
     let (opts, outcome, mut report) = calibrated();
     let t0 = outcome.synced.samples[0].pair.t0;
-    report.health.push(odocal_pipeline::Finding {
-        kind: odocal_pipeline::FaultKind::Slip,
-        severity: odocal_pipeline::Severity::Warning,
-        count: 1,
-        first_line: Some(1234),
-        time: Some(t0 + 10.0),
-        message: "rotation of scan matching and odometry disagree for 2.5 s".into(),
-    });
-    report.checks.push(Finding {
-        kind: "two_halves".into(),
-        severity: Severity::Info,
-        count: 6,
-        first_line: None,
-        time: None,
-        spans: vec![[t0 + 10.0, t0 + 12.5]],
-        message: "the two halves agree within 2σ".into(),
-    });
+    report.health.push(
+        Finding::warning(
+            FindingKind::Slip,
+            "rotation of scan matching and odometry disagree for 2.5 s",
+        )
+        .at(1234, t0 + 10.0),
+    );
+    report.checks.push(
+        Finding::note(FindingKind::TwoHalves, "the two halves agree within 2σ")
+            .count(6)
+            .spans(vec![[t0 + 10.0, t0 + 12.5]]),
+    );
     report.provenance = Some(Provenance {
         command_line: "odocal calibrate fixtures/demo.log --report r.html".into(),
         version: "0.1.0".into(),

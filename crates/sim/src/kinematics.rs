@@ -6,7 +6,7 @@
 //! robot frame has x forward and y to the left.
 
 use crate::error::SimError;
-use odocal_geom::{one_minus_cos_over_x, sin_over_x, Pose2};
+use odocal_geom::{one_minus_cos_over_x, sin_over_x, FlatParams, Pose2};
 use serde::{Deserialize, Serialize};
 
 /// The six calibration parameters of a differential-drive robot with a laser.
@@ -20,6 +20,24 @@ pub struct RobotParams {
     pub b: f64,
     /// Pose of the laser in the robot frame (m, m, rad).
     pub laser: Pose2,
+}
+
+impl From<RobotParams> for FlatParams {
+    fn from(p: RobotParams) -> Self {
+        FlatParams::new(p.r_l, p.r_r, p.b, &p.laser)
+    }
+}
+
+impl From<FlatParams> for RobotParams {
+    /// ℓθ is wrapped.
+    fn from(p: FlatParams) -> Self {
+        RobotParams {
+            r_l: p.r_l,
+            r_r: p.r_r,
+            b: p.b,
+            laser: p.laser(),
+        }
+    }
 }
 
 impl RobotParams {

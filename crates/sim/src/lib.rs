@@ -65,6 +65,6 @@ pub use presets::{
     SECONDS_PER_SAMPLE,
 };
 pub use simulation::{simulate, simulate_in, SimEncoderRecord, SimRun, SimScan};
-pub use truth::{GroundTruth, TruthFaults, TruthParams, TruthScan, TruthSlip, TRUTH_FORMAT};
+pub use truth::{GroundTruth, TruthFaults, TruthScan, TruthSlip, TRUTH_FORMAT};
 pub use world::{Segment, World};
 pub use world_presets::WORLD_NAMES;

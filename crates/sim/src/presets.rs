@@ -17,8 +17,7 @@ use crate::kinematics::RobotParams;
 use crate::laser::LaserConfig;
 use crate::planner::TrajectoryKind;
 use crate::robot_classes;
-use crate::truth::TruthParams;
-use odocal_geom::Pose2;
+use odocal_geom::{FlatParams, Pose2};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
@@ -48,7 +47,7 @@ pub struct TableRow {
     /// Number of samples of the experiment.
     pub samples: u64,
     /// The calibrated parameters in SI units, under the headings as printed.
-    pub si: TruthParams,
+    pub si: FlatParams,
     /// The printed J21 (`−r_L/b`), when the table has it.
     #[serde(default, alias = "J21")]
     pub j21: Option<f64>,
@@ -60,7 +59,7 @@ pub struct TableRow {
 impl TableRow {
     /// The row's true parameters: `si`, except that with J columns the radii are
     /// `r_L = −b·J21`, `r_R = b·J22`.
-    pub fn truth(&self) -> TruthParams {
+    pub fn truth(&self) -> FlatParams {
         let mut p = self.si;
         if let (Some(j21), Some(j22)) = (self.j21, self.j22) {
             p.r_l = -p.b * j21;
@@ -214,13 +213,7 @@ impl PresetRegistry {
             return Ok(c);
         }
         if let Some(row) = self.rows.iter().find(|r| r.name == name) {
-            let t = row.truth();
-            let truth = RobotParams {
-                r_l: t.r_l,
-                r_r: t.r_r,
-                b: t.b,
-                laser: Pose2::new(t.l_x, t.l_y, t.l_theta),
-            };
+            let truth = RobotParams::from(row.truth());
             return Ok(table_row_config(&row.name, &truth, row.samples));
         }
         let mut known = self.names().join(", ");

@@ -4,28 +4,11 @@ use crate::config::SimConfig;
 use crate::output::LogSummary;
 use crate::simulation::SimRun;
 use crate::world::Segment;
+use odocal_geom::FlatParams;
 use serde::{Deserialize, Serialize};
 
 /// Identifies the format of the truth JSON.
 pub const TRUTH_FORMAT: &str = "odocal-sim-truth/1";
-
-/// The six parameters, flat, in metres and radians (the truth file's `params`, and a
-/// Table I row's `si`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct TruthParams {
-    /// Left wheel radius (m).
-    pub r_l: f64,
-    /// Right wheel radius (m).
-    pub r_r: f64,
-    /// Wheel distance (m).
-    pub b: f64,
-    /// Laser x in the robot frame (m).
-    pub l_x: f64,
-    /// Laser y in the robot frame (m).
-    pub l_y: f64,
-    /// Laser heading in the robot frame (rad).
-    pub l_theta: f64,
-}
 
 /// A wheel-slip episode on the log's (encoder) clock.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -82,9 +65,9 @@ pub struct GroundTruth {
     /// The seed.
     pub seed: u64,
     /// The true parameters.
-    pub params: TruthParams,
+    pub params: FlatParams,
     /// The nominal parameters the ODOM messages were computed with.
-    pub nominal: TruthParams,
+    pub nominal: FlatParams,
     /// Encoder ticks per wheel revolution.
     pub ticks_per_revolution: f64,
     /// Counter modulus, when the counters wrap.
@@ -111,14 +94,6 @@ impl GroundTruth {
     /// The truth of `run` as written with `summary`.
     pub fn new(run: &SimRun, summary: &LogSummary) -> Self {
         let c = &run.config;
-        let flat = |p: &crate::RobotParams| TruthParams {
-            r_l: p.r_l,
-            r_r: p.r_r,
-            b: p.b,
-            l_x: p.laser.x,
-            l_y: p.laser.y,
-            l_theta: p.laser.theta,
-        };
         let start = (c.start_time * 1e6).round() * 1e-6;
         let slip_intervals = run
             .slips
@@ -146,8 +121,8 @@ impl GroundTruth {
             generator: format!("odocal-sim {}", env!("CARGO_PKG_VERSION")),
             preset: c.preset.clone(),
             seed: c.seed,
-            params: flat(&c.robot),
-            nominal: flat(&c.nominal),
+            params: c.robot.into(),
+            nominal: c.nominal.into(),
             ticks_per_revolution: c.encoder.ticks_per_revolution,
             encoder_modulus: c.encoder.modulus,
             initial_ticks: c.encoder.initial_ticks,

@@ -1,6 +1,6 @@
 //! The six calibration parameters.
 
-use odocal_geom::{wrap_angle, Pose2};
+use odocal_geom::{wrap_angle, FlatParams, Pose2};
 use serde::{Deserialize, Serialize};
 
 /// Names of the six parameters, in the order used by every vector and covariance of
@@ -65,5 +65,18 @@ impl Params {
             a[4] - b[4],
             wrap_angle(a[5] - b[5]),
         ]
+    }
+}
+
+impl From<Params> for FlatParams {
+    fn from(p: Params) -> Self {
+        FlatParams::new(p.r_l, p.r_r, p.b, &p.laser)
+    }
+}
+
+impl From<FlatParams> for Params {
+    /// ℓθ is wrapped.
+    fn from(p: FlatParams) -> Self {
+        Params::from_vector(p.to_array())
     }
 }

@@ -4,7 +4,8 @@
 //! reset: records on both sides of it cannot share one time line with the other
 //! stream, so only the longest stretch between jumps is kept.
 
-use super::{in_file_order, FaultKind, Finding, Severity};
+use super::in_file_order;
+use crate::finding::{Finding, FindingKind};
 
 /// A step back larger than this many median periods (and at least
 /// [`MIN_JUMP_S`]) is a clock jump, not records out of order.
@@ -52,18 +53,18 @@ pub fn keep_longest_run<T: Copy>(
     let mut findings = Vec::new();
     if small_steps > 0 {
         let k = first_small.unwrap_or(0);
-        findings.push(Finding {
-            kind: FaultKind::OutOfOrder,
-            severity: Severity::Info,
-            count: small_steps,
-            first_line: Some(line(&order[k])),
-            time: Some(times[k]),
-            message: format!(
-                "{small_steps} {stream} record(s) are out of timestamp order (small steps \
-                 back, first at line {}); the stream was sorted by timestamp",
-                line(&order[k])
-            ),
-        });
+        findings.push(
+            Finding::note(
+                FindingKind::OutOfOrder,
+                format!(
+                    "{small_steps} {stream} record(s) are out of timestamp order (small steps \
+                     back, first at line {}); the stream was sorted by timestamp",
+                    line(&order[k])
+                ),
+            )
+            .count(small_steps)
+            .at(line(&order[k]), times[k]),
+        );
     }
     if jumps.is_empty() {
         return findings;
@@ -78,21 +79,21 @@ pub fn keep_longest_run<T: Copy>(
     records.retain(|r| (lo..=hi).contains(&line(r)));
     let (k, back) = jumps[0];
     let at = line(&order[k]);
-    findings.push(Finding {
-        kind: FaultKind::ClockJump,
-        severity: Severity::Warning,
-        count: jumps.len() as u64,
-        first_line: Some(at),
-        time: Some(times[k]),
-        message: format!(
-            "the {stream} clock jumps back {back:.3} s at line {at} ({} jump(s) in all); \
-             records on the two sides cannot be put on one time line with the other \
-             stream, so only the longest stretch (lines {lo}–{hi}) is used and {dropped} \
-             {stream} record(s) were left out; fix the clock (no clock steps while \
-             logging) or cut the log at line {at}",
-            jumps.len()
-        ),
-    });
+    findings.push(
+        Finding::warning(
+            FindingKind::ClockJump,
+            format!(
+                "the {stream} clock jumps back {back:.3} s at line {at} ({} jump(s) in all); \
+                 records on the two sides cannot be put on one time line with the other \
+                 stream, so only the longest stretch (lines {lo}–{hi}) is used and {dropped} \
+                 {stream} record(s) were left out; fix the clock (no clock steps while \
+                 logging) or cut the log at line {at}",
+                jumps.len()
+            ),
+        )
+        .count(jumps.len() as u64)
+        .at(at, times[k]),
+    );
     findings
 }
 
@@ -108,7 +109,7 @@ mod tests {
         r.sort_by(|a, b| a.0.total_cmp(&b.0));
         let f = keep_longest_run(&mut r, "laser", |x| x.0, |x| x.1);
         assert_eq!(f.len(), 1);
-        assert_eq!(f[0].kind, FaultKind::ClockJump);
+        assert_eq!(f[0].kind, FindingKind::ClockJump);
         assert_eq!(f[0].first_line, Some(61));
         assert_eq!(r.len(), 60);
         assert!(r.iter().all(|x| x.1 <= 60));
@@ -122,7 +123,7 @@ mod tests {
         r.sort_by(|a, b| a.0.total_cmp(&b.0));
         let f = keep_longest_run(&mut r, "encoder", |x| x.0, |x| x.1);
         assert_eq!(f.len(), 1);
-        assert_eq!(f[0].kind, FaultKind::OutOfOrder);
+        assert_eq!(f[0].kind, FindingKind::OutOfOrder);
         assert_eq!(r.len(), 50);
     }
 }

@@ -4,7 +4,7 @@
 //! is where the clocks agree. It costs a few interpolations per sample and grid point,
 //! not a solve.
 
-use super::{FaultKind, Finding, Severity};
+use crate::finding::{Finding, FindingKind};
 use crate::run::{Options, Synchronized};
 use crate::sync::EncoderTrack;
 use odocal_log::Log;
@@ -128,13 +128,9 @@ pub fn quick_check(log: &Log, synced: &Synchronized, opts: &Options) -> Option<F
         return None;
     }
     let range = suggested_range(q.offset - used);
-    Some(Finding {
-        kind: FaultKind::ClockOffset,
-        severity: Severity::Warning,
-        count: 1,
-        first_line: None,
-        time: None,
-        message: format!(
+    Some(Finding::warning(
+        FindingKind::ClockOffset,
+        format!(
             "the laser clock looks offset from the encoder clock by about {:+.2} s \
              (rotations from scan matching and from the wheels agree best there: \
              correlation {:.3} against {:.3} at the {used:+.2} s used); the results are \
@@ -142,7 +138,7 @@ pub fn quick_check(log: &Log, synced: &Synchronized, opts: &Options) -> Option<F
              --time-offset-range {range}` or `--time-offset {:.2}`",
             q.offset, q.correlation, q.correlation_in_use, q.offset
         ),
-    })
+    ))
 }
 
 /// A search half-width (s) that comfortably holds an offset `d` from the start.

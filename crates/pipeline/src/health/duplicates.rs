@@ -2,7 +2,7 @@
 //! timestamp (timestamps rounded by the logger: encoder records merged, scans kept
 //! once), which would otherwise be used twice or give zero-length intervals.
 
-use super::{FaultKind, Finding, Severity};
+use crate::finding::{Finding, FindingKind};
 use odocal_log::{EncoderRecord, ScanMeta, ScanStore};
 
 /// True when two scans have the same geometry and bit-identical ranges.
@@ -83,36 +83,36 @@ pub fn encoders(records: &mut Vec<EncoderRecord>) -> Vec<Finding> {
     flush(&mut group, &mut out);
     let mut findings = Vec::new();
     if let Some(r) = first_repeat {
-        findings.push(Finding {
-            kind: FaultKind::Duplicate,
-            severity: Severity::Warning,
-            count: repeats,
-            first_line: Some(r.line),
-            time: Some(r.t),
-            message: format!(
-                "{repeats} ENCODER record(s) repeat an earlier one exactly (same timestamp \
-                 and counts, first at line {}); the repeats were dropped; check that the \
-                 logger writes each message once",
-                r.line
-            ),
-        });
+        findings.push(
+            Finding::warning(
+                FindingKind::Duplicate,
+                format!(
+                    "{repeats} ENCODER record(s) repeat an earlier one exactly (same timestamp \
+                     and counts, first at line {}); the repeats were dropped; check that the \
+                     logger writes each message once",
+                    r.line
+                ),
+            )
+            .count(repeats)
+            .at(r.line, r.t),
+        );
     }
     if let Some(r) = first_merged {
         let res = resolution(out.iter().map(|r| r.t));
-        findings.push(Finding {
-            kind: FaultKind::TimestampCollision,
-            severity: Severity::Warning,
-            count: merged,
-            first_line: Some(r.line),
-            time: Some(r.t),
-            message: format!(
-                "{merged} ENCODER record(s) share their timestamp with a different record \
-                 (first at line {}; the timestamps step by {res:.3} s at least, as if \
-                 rounded); the records of each timestamp were merged into one (their mean \
-                 count), which blurs the encoder timing; log timestamps to the microsecond",
-                r.line
-            ),
-        });
+        findings.push(
+            Finding::warning(
+                FindingKind::TimestampCollision,
+                format!(
+                    "{merged} ENCODER record(s) share their timestamp with a different record \
+                     (first at line {}; the timestamps step by {res:.3} s at least, as if \
+                     rounded); the records of each timestamp were merged into one (their mean \
+                     count), which blurs the encoder timing; log timestamps to the microsecond",
+                    r.line
+                ),
+            )
+            .count(merged)
+            .at(r.line, r.t),
+        );
     }
     *records = out;
     findings
@@ -141,34 +141,34 @@ pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore) -> Vec<Finding> {
     }
     let mut findings = Vec::new();
     if let Some(s) = first_repeat {
-        findings.push(Finding {
-            kind: FaultKind::Duplicate,
-            severity: Severity::Warning,
-            count: repeats,
-            first_line: Some(s.line),
-            time: Some(s.t),
-            message: format!(
-                "{repeats} scan(s) repeat an earlier one exactly (same timestamp and ranges, \
-                 first at line {}); the repeats were dropped (used twice they would make \
-                 the σ's too small); check that the logger writes each message once",
-                s.line
-            ),
-        });
+        findings.push(
+            Finding::warning(
+                FindingKind::Duplicate,
+                format!(
+                    "{repeats} scan(s) repeat an earlier one exactly (same timestamp and ranges, \
+                     first at line {}); the repeats were dropped (used twice they would make \
+                     the σ's too small); check that the logger writes each message once",
+                    s.line
+                ),
+            )
+            .count(repeats)
+            .at(s.line, s.t),
+        );
     }
     if let Some(s) = first_collision {
-        findings.push(Finding {
-            kind: FaultKind::TimestampCollision,
-            severity: Severity::Warning,
-            count: collisions,
-            first_line: Some(s.line),
-            time: Some(s.t),
-            message: format!(
-                "{collisions} scan(s) share their timestamp with a different scan (first at \
-                 line {}); only the first scan of each timestamp was kept; log timestamps \
-                 to the microsecond",
-                s.line
-            ),
-        });
+        findings.push(
+            Finding::warning(
+                FindingKind::TimestampCollision,
+                format!(
+                    "{collisions} scan(s) share their timestamp with a different scan (first at \
+                     line {}); only the first scan of each timestamp was kept; log timestamps \
+                     to the microsecond",
+                    s.line
+                ),
+            )
+            .count(collisions)
+            .at(s.line, s.t),
+        );
     }
     *scans = out;
     findings

@@ -3,7 +3,8 @@
 //! impossible). The repeats say the robot stood still while the wheels turned.
 
 use super::duplicates::same_ranges;
-use super::{since, FaultKind, Finding, Severity};
+use super::since;
+use crate::finding::{Finding, FindingKind};
 use odocal_log::{ScanMeta, ScanStore};
 
 /// Drops scans identical to the scan before them. `scans` is sorted by time.
@@ -31,13 +32,9 @@ pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore) -> Vec<Finding> {
     };
     let t0 = scans.first().map_or(f.t, |s| s.t);
     *scans = out;
-    vec![Finding {
-        kind: FaultKind::FrozenScan,
-        severity: Severity::Warning,
-        count: dropped,
-        first_line: Some(f.line),
-        time: Some(f.t),
-        message: format!(
+    vec![Finding::warning(
+        FindingKind::FrozenScan,
+        format!(
             "{dropped} of {total} scans are identical to the scan before them (first at line \
              {}, {}; the longest frozen stretch lasts {longest:.1} s): the laser driver \
              delivered a frozen scan; the repeats were left out; check the laser's driver \
@@ -45,5 +42,7 @@ pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore) -> Vec<Finding> {
             f.line,
             since(f.t, t0)
         ),
-    }]
+    )
+    .count(dropped)
+    .at(f.line, f.t)]
 }

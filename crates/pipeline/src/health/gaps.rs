@@ -1,7 +1,8 @@
 //! Holes in a stream: intervals much longer than its usual period. Pairs across an
 //! encoder gap are discarded by the synchronization; this names them.
 
-use super::{since, FaultKind, Finding, Severity};
+use super::since;
+use crate::finding::{Finding, FindingKind, Severity};
 
 /// A step longer than this many median periods (and at least [`MIN_GAP_S`]) is a gap.
 pub const GAP_PERIODS: f64 = 5.0;
@@ -35,24 +36,25 @@ pub fn find<T>(
     let span = times[times.len() - 1] - times[0];
     let k = longest.1;
     let share = total / span.max(f64::MIN_POSITIVE);
-    Some(Finding {
-        kind: FaultKind::Gap,
-        severity: if share > 0.2 {
-            Severity::Warning
-        } else {
-            Severity::Info
-        },
-        count,
-        first_line: Some(line(&records[k])),
-        time: Some(times[k - 1]),
-        message: format!(
-            "the {stream} stream has {count} gap(s) longer than {threshold:.3} s ({:.0} % of \
-             its {span:.1} s); the longest, {:.3} s, ends at line {} ({}); scan pairs across \
-             a gap are discarded; check the logger for dropped messages",
-            100.0 * share,
-            longest.0,
-            line(&records[k]),
-            since(times[k - 1], times[0])
-        ),
-    })
+    Some(
+        Finding::new(
+            FindingKind::Gap,
+            if share > 0.2 {
+                Severity::Warning
+            } else {
+                Severity::Info
+            },
+            format!(
+                "the {stream} stream has {count} gap(s) longer than {threshold:.3} s ({:.0} % of \
+                 its {span:.1} s); the longest, {:.3} s, ends at line {} ({}); scan pairs across \
+                 a gap are discarded; check the logger for dropped messages",
+                100.0 * share,
+                longest.0,
+                line(&records[k]),
+                since(times[k - 1], times[0])
+            ),
+        )
+        .count(count)
+        .at(line(&records[k]), times[k - 1]),
+    )
 }

@@ -4,11 +4,13 @@
 //!
 //! Before synchronization ([`check_log`], on the log): clock jumps and records out of
 //! order ([`clock`]), duplicated records and colliding timestamps ([`duplicates`]),
-//! frozen scans ([`frozen`]), encoder counter wraps without a modulus ([`wraps`]),
+//! frozen scans ([`frozen`]), wheel angles wrapped to one turn ([`angle_wraps`]),
+//! encoder counter wraps without a modulus ([`wraps`]),
 //! physically impossible encoder jumps ([`spikes`]), gaps ([`gaps`]). After matching
 //! ([`after_matching`], on the samples): a large laser–encoder clock offset
 //! ([`clock_offset`]) and wheel-slip episodes ([`slip`]).
 
+pub mod angle_wraps;
 pub mod clock;
 pub mod clock_offset;
 pub mod duplicates;
@@ -18,104 +20,12 @@ pub mod slip;
 pub mod spikes;
 pub mod wraps;
 
+use crate::finding::Finding;
 use crate::run::{Options, Synchronized};
-use odocal_log::{EncoderRecord, Log, ScanMeta, ScanStore};
-use serde::Serialize;
+use odocal_log::{
+    EncoderRecord, Log, ScanMeta, ScanStore, ValueSource, WHEEL_TICKS_PER_REVOLUTION,
+};
 use std::borrow::Cow;
-use std::fmt;
-
-/// What kind of data fault a finding is about.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FaultKind {
-    /// Encoder counters wrapping with no modulus given.
-    EncoderWrap,
-    /// A stream's clock jumping backwards.
-    ClockJump,
-    /// Records slightly out of timestamp order (sorted by the reader).
-    OutOfOrder,
-    /// Records repeated exactly.
-    Duplicate,
-    /// Different records with the same timestamp (rounded timestamps).
-    TimestampCollision,
-    /// The laser repeating one scan.
-    FrozenScan,
-    /// Encoder counts jumping at a physically impossible wheel speed.
-    EncoderSpike,
-    /// A stream with a hole.
-    Gap,
-    /// A large offset between the laser clock and the encoder clock.
-    ClockOffset,
-    /// Scan matching and odometry disagreeing in rotation (wheel slip).
-    Slip,
-}
-
-impl FaultKind {
-    /// The snake_case name used in the JSON.
-    pub fn name(self) -> &'static str {
-        match self {
-            FaultKind::EncoderWrap => "encoder_wrap",
-            FaultKind::ClockJump => "clock_jump",
-            FaultKind::OutOfOrder => "out_of_order",
-            FaultKind::Duplicate => "duplicate",
-            FaultKind::TimestampCollision => "timestamp_collision",
-            FaultKind::FrozenScan => "frozen_scan",
-            FaultKind::EncoderSpike => "encoder_spike",
-            FaultKind::Gap => "gap",
-            FaultKind::ClockOffset => "clock_offset",
-            FaultKind::Slip => "slip",
-        }
-    }
-}
-
-/// How much a finding matters.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Severity {
-    /// Noted; the results are not affected.
-    Info,
-    /// Data were changed or left out, or the results may be affected.
-    Warning,
-}
-
-/// One data fault: what, how often, where, what was done and what the user can do.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Finding {
-    /// The kind of fault.
-    pub kind: FaultKind,
-    /// How much it matters.
-    pub severity: Severity,
-    /// How many records, samples or episodes it concerns.
-    pub count: u64,
-    /// 1-based line of the first occurrence, when known.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub first_line: Option<u64>,
-    /// Timestamp (s, the stream's own clock) of the first occurrence, when known.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub time: Option<f64>,
-    /// What was found, what was done, what the user can do.
-    pub message: String,
-}
-
-impl fmt::Display for Finding {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let level = match self.severity {
-            Severity::Info => "note",
-            Severity::Warning => "warning",
-        };
-        write!(f, "{level} [{}]: {}", self.kind.name(), self.message)
-    }
-}
-
-/// The findings that can explain a refusal (warnings), joined into one sentence.
-pub fn explain(findings: &[Finding]) -> Option<String> {
-    let w: Vec<&str> = findings
-        .iter()
-        .filter(|f| f.severity == Severity::Warning)
-        .map(|f| f.message.as_str())
-        .collect();
-    (!w.is_empty()).then(|| w.join("; "))
-}
 
 /// The encoder records and scans in the order they appear in the file (by line; the
 /// reader sorts each stream by timestamp).
@@ -128,6 +38,15 @@ pub(crate) fn in_file_order<T: Copy>(items: &[T], line: impl Fn(&T) -> u64) -> V
 /// Seconds from `t0` to `t`, for messages ("12.4 s into the log").
 pub(crate) fn since(t: f64, t0: f64) -> String {
     format!("{:.2} s into the log", t - t0)
+}
+
+/// True when the log's counts are wheel angles read in radians (ROS joint states,
+/// odometry), at [`WHEEL_TICKS_PER_REVOLUTION`] ticks per turn by convention.
+fn angles_in_radians(log: &Log) -> bool {
+    matches!(
+        log.params.ticks_per_revolution,
+        Some((t, ValueSource::Convention)) if t == WHEEL_TICKS_PER_REVOLUTION
+    )
 }
 
 /// Checks the log before synchronization and repairs what is safe to repair. Returns
@@ -155,6 +74,9 @@ pub fn check_log<'a>(log: &'a Log, opts: &Options) -> (Cow<'a, Log>, Vec<Finding
     findings.extend(duplicates::encoders(&mut encoders));
     findings.extend(duplicates::scans(&mut scans, &log.scans));
     findings.extend(frozen::scans(&mut scans, &log.scans));
+    if angles_in_radians(log) {
+        findings.extend(angle_wraps::unwrap(&mut encoders));
+    }
     if log.params.encoder_modulus.is_none() {
         findings.extend(wraps::unwrap(&mut encoders));
     }

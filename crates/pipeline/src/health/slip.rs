@@ -3,7 +3,8 @@
 //! whatever the laser pose; a robust straight-line fit of that relation flags the
 //! samples far from it, and consecutive flagged samples form an episode.
 
-use super::{since, FaultKind, Finding, Severity};
+use super::since;
+use crate::finding::{Finding, FindingKind, Severity};
 use crate::run::Synchronized;
 use odocal_log::Log;
 
@@ -95,27 +96,28 @@ pub fn episodes(log: &Log, synced: &Synchronized) -> Option<Finding> {
     let more = if eps.len() > 8 { ", …" } else { "" };
     let share = flags.len() as f64 / s.len() as f64;
     let line = log.scans.scans.get(s[first_k].pair.first).map(|m| m.line);
-    Some(Finding {
-        kind: FaultKind::Slip,
-        severity: if share > WARN_SHARE {
-            Severity::Warning
-        } else {
-            Severity::Info
-        },
-        count: eps.len() as u64,
-        first_line: line,
-        time: Some(s[first_k].pair.t0),
-        message: format!(
-            "scan matching and odometry disagree in rotation in {} episode(s) ({} of {} \
-             samples, {:.1} %; wheel slip or bad scan matches) at {}{more} (times into the \
-             log, first {}); the outlier rejection leaves such samples out; if there are \
-             many, drive slower, with gentler accelerations, on a floor with more grip",
-            eps.len(),
-            flags.len(),
-            s.len(),
-            100.0 * share,
-            listed.join(", "),
-            since(s[first_k].pair.t0, t_start)
-        ),
-    })
+    Some(
+        Finding::new(
+            FindingKind::Slip,
+            if share > WARN_SHARE {
+                Severity::Warning
+            } else {
+                Severity::Info
+            },
+            format!(
+                "scan matching and odometry disagree in rotation in {} episode(s) ({} of {} \
+                 samples, {:.1} %; wheel slip or bad scan matches) at {}{more} (times into the \
+                 log, first {}); the outlier rejection leaves such samples out; if there are \
+                 many, drive slower, with gentler accelerations, on a floor with more grip",
+                eps.len(),
+                flags.len(),
+                s.len(),
+                100.0 * share,
+                listed.join(", "),
+                since(s[first_k].pair.t0, t_start)
+            ),
+        )
+        .count(eps.len() as u64)
+        .at(line, s[first_k].pair.t0),
+    )
 }

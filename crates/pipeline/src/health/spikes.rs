@@ -3,7 +3,7 @@
 //! neighbouring speed, so that no interval sees it).
 
 use super::wraps::steps;
-use super::{FaultKind, Finding, Severity};
+use crate::finding::{Finding, FindingKind};
 use odocal_log::EncoderRecord;
 use std::f64::consts::TAU;
 
@@ -137,20 +137,20 @@ pub fn repair(
         Some(t) => format!("{:.3e} rad/s", worst * TAU / t),
         None => format!("{worst:.3e} ticks/s"),
     };
-    Some(Finding {
-        kind: FaultKind::EncoderSpike,
-        severity: Severity::Warning,
-        count: spikes + bridged,
-        first_line: Some(f.line),
-        time: Some(f.t),
-        message: format!(
-            "ENCODER counts jump at a physically impossible wheel speed (up to {speed}, \
-             first at line {}): {spikes} isolated bad record(s) were dropped and {bridged} \
-             lasting jump(s) (counter resets) bridged with the speed around them; check the \
-             encoder wiring and the logger",
-            f.line
-        ),
-    })
+    Some(
+        Finding::warning(
+            FindingKind::EncoderSpike,
+            format!(
+                "ENCODER counts jump at a physically impossible wheel speed (up to {speed}, \
+                 first at line {}): {spikes} isolated bad record(s) were dropped and {bridged} \
+                 lasting jump(s) (counter resets) bridged with the speed around them; check the \
+                 encoder wiring and the logger",
+                f.line
+            ),
+        )
+        .count(spikes + bridged)
+        .at(f.line, f.t),
+    )
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! the modulus: the modulus is inferred from the jumps — the power of two they are
 //! away from an ordinary step — and the counts are unwrapped.
 
-use super::{FaultKind, Finding, Severity};
+use crate::finding::{Finding, FindingKind};
 use odocal_log::EncoderRecord;
 
 /// Smallest modulus considered: 2^8.
@@ -110,19 +110,19 @@ pub fn unwrap(records: &mut [EncoderRecord]) -> Option<Finding> {
     let k = first?;
     let rec = records[k];
     let bits = m.trailing_zeros();
-    Some(Finding {
-        kind: FaultKind::EncoderWrap,
-        severity: Severity::Warning,
-        count: wraps,
-        first_line: Some(rec.line),
-        time: Some(rec.t),
-        message: format!(
-            "the encoder counters wrap at {m} (2^{bits}): {wraps} jump(s) of ±{m} ticks, \
-             first at line {}, and the log gives no modulus; the counts were unwrapped; add \
-             `PARAM robot_encoder_modulus {m}` to the log or pass `--encoder-modulus {m}`",
-            rec.line
-        ),
-    })
+    Some(
+        Finding::warning(
+            FindingKind::EncoderWrap,
+            format!(
+                "the encoder counters wrap at {m} (2^{bits}): {wraps} jump(s) of ±{m} ticks, \
+                 first at line {}, and the log gives no modulus; the counts were unwrapped; add \
+                 `PARAM robot_encoder_modulus {m}` to the log or pass `--encoder-modulus {m}`",
+                rec.line
+            ),
+        )
+        .count(wraps)
+        .at(rec.line, rec.t),
+    )
 }
 
 #[cfg(test)]
@@ -151,7 +151,7 @@ mod tests {
             .collect();
         let mut r = recs(&wrapped);
         let f = unwrap(&mut r).expect("a finding");
-        assert_eq!(f.kind, FaultKind::EncoderWrap);
+        assert_eq!(f.kind, FindingKind::EncoderWrap);
         assert!(f.message.contains("65536"), "{}", f.message);
         for (a, b) in r.windows(2).zip(truth.windows(2)) {
             assert_eq!(a[1].left - a[0].left, b[1].0 - b[0].0);

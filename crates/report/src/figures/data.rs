@@ -5,7 +5,7 @@ use crate::report::Report;
 use odocal_geom::Pose2;
 use odocal_pipeline::health::slip::flagged;
 use odocal_pipeline::samples::PairSample;
-use odocal_pipeline::FaultKind;
+use odocal_pipeline::FindingKind;
 use odocal_pipeline::{Options, Outcome};
 use odocal_solver::{Params, Predictor, Sample};
 
@@ -30,7 +30,7 @@ pub struct FigureData<'a> {
     /// Estimated scan-matching σ (m, m, rad).
     pub sm_sigma: [f64; 3],
     /// Time spans to shade (s since the first sample), with their kind.
-    pub spans: Vec<(f64, f64, String)>,
+    pub spans: Vec<(f64, f64, FindingKind)>,
     /// Kinds of motion nearly absent.
     pub missing: Vec<&'static str>,
 }
@@ -49,15 +49,15 @@ pub fn nominal_params(estimate: &Params) -> Params {
 }
 
 /// The time spans (s since `t0`) of the runs of consecutive flagged samples.
-fn slip_spans(pairs: &[PairSample], flagged: &[usize], t0: f64) -> Vec<(f64, f64, String)> {
-    let mut out: Vec<(f64, f64, String)> = Vec::new();
+fn slip_spans(pairs: &[PairSample], flagged: &[usize], t0: f64) -> Vec<(f64, f64, FindingKind)> {
+    let mut out: Vec<(f64, f64, FindingKind)> = Vec::new();
     let mut last: Option<usize> = None;
     for &k in flagged {
         let Some(p) = pairs.get(k) else { continue };
         let (a, b) = (p.pair.t0 - t0, p.pair.t1 - t0);
         match (last, out.last_mut()) {
             (Some(l), Some(span)) if k == l + 1 => span.1 = b,
-            _ => out.push((a, b, "slip".into())),
+            _ => out.push((a, b, FindingKind::Slip)),
         }
         last = Some(k);
     }
@@ -87,16 +87,13 @@ impl<'a> FigureData<'a> {
                 "odometry, equal radii, laser at origin",
             ),
         };
-        let mut spans: Vec<(f64, f64, String)> = report
-            .checks
+        let mut spans: Vec<(f64, f64, FindingKind)> = report
+            .health
             .iter()
-            .flat_map(|f| {
-                f.spans
-                    .iter()
-                    .map(|s| (s[0] - t0, s[1] - t0, f.kind.clone()))
-            })
+            .chain(&report.checks)
+            .flat_map(|f| f.spans.iter().map(|s| (s[0] - t0, s[1] - t0, f.kind)))
             .collect();
-        if report.health.iter().any(|f| f.kind == FaultKind::Slip) {
+        if report.health.iter().any(|f| f.kind == FindingKind::Slip) {
             spans.extend(slip_spans(pairs, &flagged(&outcome.synced), t0));
         }
         FigureData {
