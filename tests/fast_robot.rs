@@ -19,6 +19,7 @@ use odocal_log::{read_log, ReadOptions};
 use odocal_pipeline::sync::DiscardReason;
 use odocal_pipeline::{calibrate_log, FindingKind, NoProgress, Options, Outcome, PipelineError};
 use odocal_sim::TrajectoryKind;
+use odocal_solver::Verdict;
 use std::path::{Path, PathBuf};
 
 /// χ² at the 3σ level (p = 0.9973) for 1 to 6 degrees of freedom.
@@ -161,6 +162,42 @@ fn gentle_driver_without_spins_is_refused_or_agrees() {
     // Turns no tighter than 5 m: without the offset estimate this reproduces the real
     // log's refusal ("the data do not determine l_y").
     check_pair((1305, 1306), 5.0);
+}
+
+/// `--accept-weak` decides whether numbers are returned, never which: the first
+/// guesses and the clock-offset search solve without verdicts. (Before, their solves
+/// refused weak data; with `--estimate-time-offset` these two gentle-driver logs were
+/// then refused as "l_y weak" although with `--accept-weak` every parameter was judged
+/// well determined and within 2.2σ of the truth.)
+#[test]
+fn accept_weak_changes_whether_not_which_numbers() {
+    for seed in [6, 17] {
+        let (path, _) = fast_robot_log(seed, 10.0);
+        let strict = calibrate(&path, &with_offset_estimate());
+        let lenient = Options {
+            accept_weak: true,
+            ..with_offset_estimate()
+        };
+        let lenient = calibrate(&path, &lenient).expect("numbers with accept_weak");
+        match strict {
+            Ok(o) => assert_eq!(
+                o.calibration.params.to_vector(),
+                lenient.calibration.params.to_vector(),
+                "seed {seed}"
+            ),
+            Err(e) => assert!(
+                lenient
+                    .calibration
+                    .observability
+                    .parameters
+                    .iter()
+                    .any(|p| p.verdict != Verdict::WellDetermined),
+                "seed {seed}: refused ({e}) although --accept-weak judges every parameter \
+                 well determined"
+            ),
+        }
+        cleanup(&path);
+    }
 }
 
 #[test]

@@ -286,8 +286,12 @@ pub fn synchronize_and_match(
                 Some(s.to_solver(opts.use_profile, false))
             })
             .collect();
+        // Only first guesses: never judged, so never refused (the verdicts, and
+        // --accept-weak, are for the final solve; a refusal here would leave the
+        // pairs without guesses or sweep compensation and change the final data).
         let rough = SolveOptions {
             refine: false,
+            accept_weak: true,
             ..opts.solve_options()
         };
         guess_params = odocal_solver::calibrate(&samples, &rough)

@@ -188,6 +188,12 @@ impl SyncLimits {
     }
 }
 
+/// Longest piece (s) of an encoder profile: sparser records (counts stored with each
+/// scan at 10 Hz, say) are cut into pieces of at most this length on the interpolating
+/// curve, so that the profile follows the speed within the span; records at 50 Hz and
+/// more are pieces as they are.
+pub const MAX_PIECE_S: f64 = 0.025;
+
 /// The encoder stream, ready for interpolation.
 #[derive(Debug, Clone, Copy)]
 pub struct EncoderTrack<'a> {
@@ -229,19 +235,83 @@ impl<'a> EncoderTrack<'a> {
         Ok(i)
     }
 
-    /// Cumulative ticks (left, right), linearly interpolated between records `i-1`, `i`.
+    /// Cumulative ticks (left, right) at `t` between records `i-1` and `i`: the cubic
+    /// Hermite curve through the two records with the slopes of
+    /// [`EncoderTrack::slope`]. Exact on counts that grow with constant acceleration
+    /// (linear interpolation is not: with encoder records 0.1 s apart, as when the counts
+    /// are stored with each scan, its error at the ends of the intervals biased the wheel
+    /// radii by about 1σ per 75 s of a 0.6 m/s robot).
     fn ticks_between(&self, i: usize, t: f64) -> (f64, f64) {
         let a = &self.records[i - 1];
         let b = &self.records[i];
         let span = b.t - a.t;
-        let u = if span > 0.0 {
-            ((t - a.t) / span).clamp(0.0, 1.0)
-        } else {
-            1.0
+        if span.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return (b.left as f64, b.right as f64);
+        }
+        let u = ((t - a.t) / span).clamp(0.0, 1.0);
+        let (sa, sb) = (self.slope(i - 1), self.slope(i));
+        let h00 = (1.0 + 2.0 * u) * (1.0 - u) * (1.0 - u);
+        let h10 = u * (1.0 - u) * (1.0 - u);
+        let h01 = u * u * (3.0 - 2.0 * u);
+        let h11 = u * u * (u - 1.0);
+        let curve = |pa: i64, pb: i64, ma: f64, mb: f64| {
+            h00 * pa as f64 + h10 * span * ma + h01 * pb as f64 + h11 * span * mb
         };
-        let l = a.left as f64 + u * (b.left - a.left) as f64;
-        let r = a.right as f64 + u * (b.right - a.right) as f64;
-        (l, r)
+        (
+            curve(a.left, b.left, sa.0, sb.0),
+            curve(a.right, b.right, sa.1, sb.1),
+        )
+    }
+
+    /// The count rates (ticks/s, left and right) at record `k`: the three-point
+    /// derivative from the two neighbouring records (the secant of the one segment at
+    /// the ends of the stream or next to colliding timestamps).
+    fn slope(&self, k: usize) -> (f64, f64) {
+        let secant = |j: usize| -> Option<(f64, f64, f64)> {
+            let (p, q) = (self.records.get(j)?, self.records.get(j + 1)?);
+            let h = q.t - p.t;
+            (h > 0.0).then(|| {
+                (
+                    h,
+                    (q.left - p.left) as f64 / h,
+                    (q.right - p.right) as f64 / h,
+                )
+            })
+        };
+        let before = k.checked_sub(1).and_then(secant);
+        match (before, secant(k)) {
+            (Some((h0, l0, r0)), Some((h1, l1, r1))) => (
+                (h1 * l0 + h0 * l1) / (h0 + h1),
+                (h1 * r0 + h0 * r1) / (h0 + h1),
+            ),
+            (Some((_, l, r)), None) | (None, Some((_, l, r))) => (l, r),
+            (None, None) => (0.0, 0.0),
+        }
+    }
+
+    /// Appends the motion from `from` to `to` (time, left and right ticks), both
+    /// within the span of records `seg − 1` and `seg`, as pieces of at most
+    /// [`MAX_PIECE_S`], their counts read on the interpolating curve.
+    fn push_pieces(
+        &self,
+        profile: &mut Vec<ProfilePiece>,
+        seg: usize,
+        from: (f64, f64, f64),
+        to: (f64, f64, f64),
+    ) {
+        let n = ((to.0 - from.0) / MAX_PIECE_S - 1e-9).ceil().max(1.0) as usize;
+        let mut prev = from;
+        for k in 1..=n {
+            let next = if k == n {
+                to
+            } else {
+                let t = from.0 + (to.0 - from.0) * k as f64 / n as f64;
+                let (l, r) = self.ticks_between(seg, t);
+                (t, l, r)
+            };
+            profile.push(self.piece(next.0 - prev.0, next.1 - prev.1, next.2 - prev.2));
+            prev = next;
+        }
     }
 
     /// Cumulative ticks (left, right) at `t`, or why they are not known well enough.
@@ -273,7 +343,7 @@ impl<'a> EncoderTrack<'a> {
         // after i0); the last may sit exactly at t1, which then closes the interval.
         let mut profile = Vec::with_capacity(i1 - i0 + 1);
         let (mut tp, mut lp, mut rp) = (t0, l0, r0);
-        for rec in &self.records[i0..i1] {
+        for (k, rec) in self.records[i0..i1].iter().enumerate() {
             if rec.t >= t1 {
                 break;
             }
@@ -284,12 +354,12 @@ impl<'a> EncoderTrack<'a> {
             // its counts to the next piece, so that the pieces still sum up.
             if rec.t > tp {
                 let (l, r) = (rec.left as f64, rec.right as f64);
-                profile.push(self.piece(rec.t - tp, l - lp, r - rp));
+                self.push_pieces(&mut profile, i0 + k, (tp, lp, rp), (rec.t, l, r));
                 (tp, lp, rp) = (rec.t, l, r);
             }
         }
         if t1 > tp {
-            profile.push(self.piece(t1 - tp, l1 - lp, r1 - rp));
+            self.push_pieces(&mut profile, i1, (tp, lp, rp), (t1, l1, r1));
         }
         Ok(WheelMotion {
             t0,
@@ -397,6 +467,40 @@ mod tests {
     }
 
     #[test]
+    fn sparse_records_are_interpolated_exactly_under_constant_acceleration() {
+        // Counts at 10 Hz of wheels accelerating uniformly (as stored with each scan):
+        // the motion between instants off the records, and every piece of its
+        // profile, are exact (linear interpolation is off by a·Δt²/8 at the ends).
+        let angle = |t: f64| 3.0 * t + 40.0 * t * t;
+        let recs: Vec<EncoderRecord> = (0..30)
+            .map(|k| {
+                let t = k as f64 * 0.1;
+                rec(t, (1e6 * angle(t)) as i64, (2e6 * angle(t)) as i64)
+            })
+            .collect();
+        let track = EncoderTrack::new(&recs, 1e6 * std::f64::consts::TAU);
+        let lim = SyncLimits {
+            max_encoder_gap: 0.2,
+            ..limits()
+        };
+        let (t0, t1) = (1.033, 1.433);
+        let m = track.motion(t0, t1, &lim).unwrap();
+        assert!(
+            (m.dphi_l - (angle(t1) - angle(t0))).abs() < 1e-5,
+            "{}",
+            m.dphi_l
+        );
+        assert!((m.dphi_r - 2.0 * (angle(t1) - angle(t0))).abs() < 1e-5);
+        let mut t = t0;
+        for p in &m.profile {
+            assert!(p.dt <= MAX_PIECE_S + 1e-12);
+            assert!((p.dphi_l - (angle(t + p.dt) - angle(t))).abs() < 1e-5);
+            t += p.dt;
+        }
+        assert!((t - t1).abs() < 1e-12);
+    }
+
+    #[test]
     fn records_at_the_interval_ends() {
         let recs: Vec<EncoderRecord> = (0..11)
             .map(|k| rec(k as f64 * 0.1, 10 * k, 10 * k))
@@ -407,7 +511,8 @@ mod tests {
             ..limits()
         };
         let m = track.motion(0.2, 1.0, &lim).unwrap();
-        assert_eq!(m.profile.len(), 8);
+        // Eight record spans of 0.1 s, each cut into four pieces of 25 ms.
+        assert_eq!(m.profile.len(), 32);
         assert!((m.dphi_l - 80.0 * std::f64::consts::TAU / 100.0).abs() < 1e-12);
         assert!(track.motion(0.2, 1.0001, &lim).is_err());
     }

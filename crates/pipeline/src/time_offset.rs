@@ -96,6 +96,9 @@ impl Problem<'_> {
         let samples = self.samples_at(offset, every);
         let mut solve = self.opts.solve_options();
         solve.refine = false;
+        // Every trial offset is solved, weak or not: a refusal would make its cost
+        // infinite and move the estimate depending on --accept-weak.
+        solve.accept_weak = true;
         match odocal_solver::calibrate(&samples, &solve) {
             Ok(c) => self.cost_with(&c.params, &samples),
             Err(_) => f64::INFINITY,
