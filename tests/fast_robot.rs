@@ -91,7 +91,7 @@ type Estimate = ([f64; 6], [[f64; 6]; 6]);
 /// read-time jitter.
 fn check_log(label: &str, path: &Path, truth: &Truth) -> Option<Estimate> {
     match checked_log(label, path, truth, false) {
-        Checked::Numbers(e) => Some(e),
+        Checked::Numbers(e) => Some(*e),
         Checked::Refused | Checked::Warned => None,
     }
 }
@@ -99,7 +99,7 @@ fn check_log(label: &str, path: &Path, truth: &Truth) -> Option<Estimate> {
 /// What the recommended command gave.
 enum Checked {
     /// Numbers within 4σ, no read-time jitter warning.
-    Numbers(Estimate),
+    Numbers(Box<Estimate>),
     /// A reasoned refusal.
     Refused,
     /// Numbers with the read-time jitter warning (allowed when `jitter_allowed`).
@@ -141,7 +141,7 @@ fn checked_log(label: &str, path: &Path, truth: &Truth, jitter_allowed: bool) ->
             }
             println!("{line}");
             assert!(beyond.is_empty(), "{label}: {beyond:?} beyond 4σ: {line}");
-            Checked::Numbers((est, c.covariance))
+            Checked::Numbers(Box::new((est, c.covariance)))
         }
     }
 }

@@ -97,7 +97,7 @@ fn line_fit(pts: &[(f64, f64)], weight: impl Fn(f64) -> f64) -> Option<(f64, f64
         .zip(&ws)
         .map(|(p, w)| w * (p.1 - mx).powi(2))
         .sum();
-    if !(sxx > 0.0) {
+    if sxx.is_nan() || sxx <= 0.0 {
         return None;
     }
     let b = pts
@@ -120,13 +120,11 @@ pub fn estimate(encoders: &[EncoderRecord]) -> Option<ReadJitter> {
     let mut pts: Vec<(f64, f64)> = Vec::new();
     for w in encoders.chunks_exact(4) {
         let t = [w[0].t, w[1].t, w[2].t, w[3].t];
-        let y0 = [w[0].left, w[0].right];
-        for side in 0..2 {
+        let left = |r: &EncoderRecord| r.left;
+        let right = |r: &EncoderRecord| r.right;
+        for count in [&left as &dyn Fn(&EncoderRecord) -> i64, &right] {
             // Relative to the first count: exact in f64 for any counter.
-            let y = std::array::from_fn(|i| {
-                let c = if side == 0 { w[i].left } else { w[i].right };
-                c.wrapping_sub(y0[side]) as f64
-            });
+            let y = std::array::from_fn(|i| count(&w[i]).wrapping_sub(count(&w[0])) as f64);
             pts.extend(window(t, y));
         }
     }
