@@ -111,7 +111,10 @@ pub fn check_log<'a>(log: &'a Log, opts: &Options) -> (Cow<'a, Log>, Vec<Finding
 /// slip episodes.
 pub fn after_matching(log: &Log, synced: &Synchronized, opts: &Options) -> Vec<Finding> {
     let mut findings = Vec::new();
-    findings.extend(clock_offset::quick_check(log, synced, opts));
+    findings.extend(
+        clock_offset::found_offset(log, synced, opts)
+            .map(|q| clock_offset::found_offset_finding(&q, synced.time_offset, false)),
+    );
     findings.extend(slip::episodes(log, synced));
     findings
 }
