@@ -248,16 +248,14 @@ fn encoder_spikes_are_dropped() {
 fn a_large_clock_offset_is_flagged_and_estimated_first() {
     let (lines, truth) = sim_lines(60.0, 49, |c| c.faults.clock_offset = 0.3);
     let log = read(&lines);
-    // Without the flag: the quick check names the offset.
-    let o = run(
-        &log,
-        &Options {
-            accept_weak: true,
-            ..Options::default()
-        },
-    );
-    let text = match &o {
-        Ok(o) => finding(o, FindingKind::ClockOffset).message.clone(),
+    // Given as known (`--time-offset`): the quick check names the offset and the flags.
+    let known = Options {
+        accept_weak: true,
+        estimate_found_time_offset: false,
+        ..Options::default()
+    };
+    let text = match run(&log, &known) {
+        Ok(o) => finding(&o, FindingKind::ClockOffset).message.clone(),
         Err(e) => e.to_string(),
     };
     println!("{text}");
@@ -265,6 +263,16 @@ fn a_large_clock_offset_is_flagged_and_estimated_first() {
         text.contains("+0.30 s") && text.contains("--estimate-time-offset"),
         "{text}"
     );
+    // Not given: the offset the quick check finds is estimated, and said so.
+    let o = run(&log, &Options::default()).expect("calibrates");
+    let text = &finding(&o, FindingKind::ClockOffset).message;
+    assert!(
+        text.contains("+0.30 s") && text.contains("was estimated"),
+        "{text}"
+    );
+    let est = o.offset.as_ref().expect("estimated").offset;
+    assert!((est - 0.3).abs() < 0.005, "estimated {est}");
+    assert_within("0.3 s offset found", &o, &truth, 1.0, 4.0);
     // With it: estimated before observability is judged.
     let opts = Options {
         estimate_time_offset: Some(0.5),

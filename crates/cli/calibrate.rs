@@ -112,7 +112,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         stride: input.stride,
         use_profile: !args.constant_speed,
         use_icp_covariance: args.icp_covariance,
-        time_offset: input.time_offset,
+        time_offset: input.time_offset.unwrap_or(0.0),
+        estimate_found_time_offset: input.time_offset.is_none(),
         estimate_time_offset: (args.estimate_time_offset || args.time_offset_range.is_some())
             .then_some(args.time_offset_range.unwrap_or(0.5)),
         second_pass: args.second_pass,

@@ -16,14 +16,11 @@ pub struct InputArgs {
     /// Pair scans K apart (default: about 0.4 s apart at the log's scan rate).
     #[arg(long, value_name = "K")]
     pub stride: Option<usize>,
-    /// Known clock offset (s): laser clock minus encoder clock.
-    #[arg(
-        long,
-        value_name = "S",
-        default_value_t = 0.0,
-        allow_negative_numbers = true
-    )]
-    pub time_offset: f64,
+    /// Known clock offset (s): laser clock minus encoder clock. Without it the clocks
+    /// are taken as recorded (offset 0), and `calibrate` estimates the offset when its
+    /// check on every run finds the clocks clearly offset.
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub time_offset: Option<f64>,
     /// Threads for scan matching (default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,

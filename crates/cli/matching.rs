@@ -31,7 +31,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         initial_params,
         ticks_per_revolution: input.read.ticks_per_rev,
         stride: input.stride,
-        time_offset: input.time_offset,
+        time_offset: input.time_offset.unwrap_or(0.0),
         ..Options::default()
     };
     let bar = Bar::for_stderr();

@@ -34,6 +34,8 @@ pub enum FindingKind {
     Slip,
     /// The two halves of the samples calibrated separately and compared.
     TwoHalves,
+    /// Wheel counts read at times that vary around their timestamps.
+    ReadJitter,
 }
 
 impl FindingKind {
@@ -52,6 +54,7 @@ impl FindingKind {
             FindingKind::ClockOffset => "clock_offset",
             FindingKind::Slip => "slip",
             FindingKind::TwoHalves => "two_halves",
+            FindingKind::ReadJitter => "read_jitter",
         }
     }
 }

@@ -45,8 +45,15 @@ pub struct Options {
     pub solve: SolveOptions,
     /// Known clock offset (s): laser clock minus encoder clock (subtracted from scan timestamps).
     pub time_offset: f64,
-    /// Estimate the offset within ±this many seconds (`None`: keep `time_offset`).
+    /// Estimate the offset within ±this many seconds (`None`: keep `time_offset`,
+    /// unless [`Options::estimate_found_time_offset`] applies).
     pub estimate_time_offset: Option<f64>,
+    /// Without [`Options::estimate_time_offset`]: when the quick check on every run
+    /// finds the clocks clearly offset from `time_offset`, estimate the offset anyway
+    /// (in a range that holds the quick check's answer) instead of calibrating at
+    /// `time_offset` with biased results. Off when the offset is known (the CLI's
+    /// `--time-offset`): then the quick check only warns.
+    pub estimate_found_time_offset: bool,
     /// Parameters for the first guesses of scan matching (odometry prediction).
     pub initial_params: Option<Params>,
     /// Without `initial_params`: match [`BOOTSTRAP_PAIRS`] evenly spread pairs (all
@@ -85,6 +92,7 @@ impl Default for Options {
             solve: SolveOptions::default(),
             time_offset: 0.0,
             estimate_time_offset: None,
+            estimate_found_time_offset: true,
             initial_params: None,
             bootstrap_guesses: true,
             second_pass: false,
@@ -479,12 +487,22 @@ pub fn calibrate_log(
     let log: &Log = &log;
     let mut synced = synchronize_and_match(log, opts, progress, &mut timing)
         .map_err(|e| PipelineError::with_faults(e, &findings))?;
-    findings.extend(health::clock_offset::quick_check(log, &synced, opts));
+    let found = health::clock_offset::found_offset(log, &synced, opts);
+    let search_range = match (opts.estimate_time_offset, found) {
+        (Some(range), _) => Some(range),
+        (None, Some(q)) if opts.estimate_found_time_offset => Some(
+            health::clock_offset::suggested_range(q.offset - synced.time_offset),
+        ),
+        _ => None,
+    };
+    findings.extend(found.map(|q| {
+        health::clock_offset::found_offset_finding(&q, synced.time_offset, search_range.is_some())
+    }));
     // A swept log is matched again after compensating with the refined estimate.
     let sweep = has_sweep(&log.scans);
 
     let mut offset = None;
-    if let Some(range) = opts.estimate_time_offset {
+    if let Some(range) = search_range {
         if !(range.is_finite() && range > 0.0) {
             return Err(PipelineError::InvalidSetting(format!(
                 "the clock-offset search range must be positive, got {range} s"

@@ -6,7 +6,8 @@
 //! order ([`clock`]), duplicated records and colliding timestamps ([`duplicates`]),
 //! frozen scans ([`frozen`]), wheel angles wrapped to one turn ([`angle_wraps`]),
 //! encoder counter wraps without a modulus ([`wraps`]),
-//! physically impossible encoder jumps ([`spikes`]), gaps ([`gaps`]). After matching
+//! physically impossible encoder jumps ([`spikes`]), gaps ([`gaps`]), counts read at
+//! times that vary around their timestamps ([`read_jitter`]). After matching
 //! ([`after_matching`], on the samples): a large laser–encoder clock offset
 //! ([`clock_offset`]) and wheel-slip episodes ([`slip`]).
 
@@ -16,6 +17,7 @@ pub mod clock_offset;
 pub mod duplicates;
 pub mod frozen;
 pub mod gaps;
+pub mod read_jitter;
 pub mod slip;
 pub mod spikes;
 pub mod wraps;
@@ -83,6 +85,7 @@ pub fn check_log<'a>(log: &'a Log, opts: &Options) -> (Cow<'a, Log>, Vec<Finding
     findings.extend(spikes::repair(&mut encoders, ticks));
     findings.extend(gaps::find(&encoders, "encoder", |r| r.t, |r| r.line));
     findings.extend(gaps::find(&scans, "laser", |s| s.t, |s| s.line));
+    findings.extend(read_jitter::estimate(&encoders).and_then(|j| read_jitter::finding(&j)));
 
     let changed = encoders != log.encoders || scans != log.scans.scans;
     let log = if changed {
@@ -108,7 +111,10 @@ pub fn check_log<'a>(log: &'a Log, opts: &Options) -> (Cow<'a, Log>, Vec<Finding
 /// slip episodes.
 pub fn after_matching(log: &Log, synced: &Synchronized, opts: &Options) -> Vec<Finding> {
     let mut findings = Vec::new();
-    findings.extend(clock_offset::quick_check(log, synced, opts));
+    findings.extend(
+        clock_offset::found_offset(log, synced, opts)
+            .map(|q| clock_offset::found_offset_finding(&q, synced.time_offset, false)),
+    );
     findings.extend(slip::episodes(log, synced));
     findings
 }
