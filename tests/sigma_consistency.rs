@@ -86,8 +86,8 @@ fn khepera_sigma_light() {
 #[ignore = "Monte Carlo, 24 two-minute Khepera logs (≈ 5 s); run by .ci/run"]
 fn khepera_sigma_is_consistent() {
     let r = rms("khepera", &errors_in_sigma("khepera", 6001..6025));
-    // The band. Measured (docs/benchmarks.md): 0.80–1.20 on these seeds,
-    // 0.79–1.05 on 40 fresh ones (6201–6240); the independent model: 0.33–0.56.
+    // The band. Measured (docs/benchmarks.md): 0.84–1.22 on these seeds,
+    // 0.80–1.07 on 40 fresh ones (6201–6240); the independent model: 0.33–0.56.
     for i in 0..6 {
         assert!((0.7..1.3).contains(&r[i]), "{}: {:.2}", NAMES[i], r[i]);
     }
@@ -96,8 +96,8 @@ fn khepera_sigma_is_consistent() {
 #[test]
 #[ignore = "Monte Carlo, 20 two-minute TurtleBot- and Pioneer-class logs each (≈ 10 s); run by .ci/run"]
 fn robot_classes_sigma() {
-    // Measured (docs/benchmarks.md): TurtleBot class 0.77–0.98, Pioneer class
-    // 0.93–1.14 (40 fresh seeds 6301–6340: 0.96–1.17 and 0.96–1.17; independent
+    // Measured (docs/benchmarks.md): TurtleBot class 0.76–0.98, Pioneer class
+    // 0.99–1.14 (40 fresh seeds 6301–6340: 0.93–1.17 and 0.98–1.22; independent
     // model: 0.39–0.62); the band as for the Khepera.
     for preset in ["turtlebot", "pioneer"] {
         let r = rms(preset, &errors_in_sigma(preset, 6101..6121));
@@ -118,8 +118,8 @@ fn short_logs_are_not_overconfident() {
     // One-minute logs (about 150 samples): the unshared noise is estimated from
     // fewer windows, and a chance low estimate would make σ far too small (its
     // uncertainty is propagated into σ). Over 20 seeds per class (360 ratios):
-    // measured 1.1 % beyond 3σ, largest 3.55σ; 40 fresh seeds per class
-    // (8101–8140, 720 ratios): 0.6 %, largest 4.3σ. A unit normal: 0.27 %. The
+    // measured 0.8 % beyond 3σ, largest 3.50σ; 40 fresh seeds per class
+    // (8101–8140, 720 ratios): 0.7 %, largest 4.3σ. A unit normal: 0.27 %. The
     // model before (unshared noise at its moment estimate + 1 SE): none, 2.5σ, its
     // σ 10–50 % too large on the radii of 2-minute logs.
     let mut all = Vec::new();

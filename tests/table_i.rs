@@ -36,8 +36,8 @@ const SEED: u64 = 1;
 /// would pass with probability 0.9973^176 ≈ 62 % only: with the shared-scan σ model the
 /// seed-1 run has lmov ℓx at 3.48σ, while over 8 other seeds lmov's worst is 2.17σ and
 /// all 1,056 estimates give RMS error/σ 0.96 with 0.5 % beyond 3σ (the second version
-/// of that model, long-run unshared noise: 1.05, 0.6 %; seed 1's worst full-size
-/// quantity k28 J22 at 3.54σ).
+/// of that model, long-run unshared noise: 1.07, 0.7 %; seed 1's worst full-size
+/// quantity k28 ℓθ at 3.36σ).
 const FAMILY_SIGMAS: f64 = 4.0;
 
 /// The published rows available here: the Table I file's and the T-RO reference's.
@@ -165,7 +165,7 @@ fn three_sigma_rule_holds_over_seeds() {
         100.0 * beyond2 as f64 / checks as f64,
         100.0 * beyond3 as f64 / checks as f64
     );
-    // Issue 13's band for honest σ (measured 1.05 with the shared-scan σ model; 0.54
+    // Issue 13's band for honest σ (measured 1.07 with the shared-scan σ model; 0.54
     // with the independent-samples model before it).
     assert!(
         rms < 1.3,

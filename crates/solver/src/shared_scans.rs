@@ -25,7 +25,7 @@
 //! the long-run variance of the residuals (what sums over many samples see) is
 //! 1.6× the lag-0/lag-1 value on Khepera logs. So `u` enters through its long-run
 //! covariance `Λ`, estimated from the sums of the residuals over overlapping
-//! windows of `m = max(20, √K, K/10)` samples: each window sum holds `m·Λ` plus the
+//! windows of `m = max(20, √K)` samples: each window sum holds `m·Λ` plus the
 //! shared errors of the scans at its ends (subtracted with `D`), less the part
 //! the fit removed from it (added back, as REML does for a variance). The
 //! estimator is unchanged (weighted least squares); its covariance is the
@@ -60,10 +60,6 @@ pub const MIN_SHARED_SCANS: usize = 20;
 /// Fewest samples per window of the long-run estimate of the unshared error (the
 /// residuals stay correlated over 10–30 samples on simulated logs).
 const MIN_WINDOW: usize = 20;
-
-/// Windows' lengths per log length of the long-run estimate (see
-/// `window_length`).
-const WINDOWS_PER_LOG: usize = 10;
 
 /// The estimated noise of samples that share scans.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -114,14 +110,12 @@ fn to_array3(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
     std::array::from_fn(|i| std::array::from_fn(|j| m[(i, j)]))
 }
 
-/// Samples per window of the long-run estimate: a tenth of the samples (a fixed
-/// number of windows, so that errors correlated over a good part of the log — the
-/// same scenes seen again — still show in the window sums; the estimate is then
-/// worth about 15 degrees of freedom whatever the log's length), at least
-/// [`MIN_WINDOW`] and `√K`, at most a third of the samples.
+/// Samples per window of the long-run estimate: `√K` (the usual choice for
+/// overlapping windows: long enough for correlation that lasts longer as logs
+/// grow, with about `1.5·√K` windows' worth of data), at least [`MIN_WINDOW`], at
+/// most a third of the samples.
 fn window_length(samples: usize) -> usize {
-    (samples / WINDOWS_PER_LOG)
-        .max((samples as f64).sqrt() as usize)
+    ((samples as f64).sqrt() as usize)
         .max(MIN_WINDOW)
         .min(samples / 3)
         .max(1)

@@ -1,7 +1,7 @@
 //! Samples that share scans: each scan brings one pose error into both samples that
 //! use it (`ŝ_k = ⊖δ_k ⊕ ŝ_k,true ⊕ δ_{k+1}`), plus each sample's own error. With the
 //! scans' times attached, the reported covariance is consistent (RMS of error/σ
-//! 0.80–1.01 over many runs);
+//! 0.80–1.04 over many runs);
 //! treated as independent, the same samples give σ 1.5–2× too large — the Khepera
 //! logs' symptom.
 
@@ -104,7 +104,7 @@ fn covariance_is_consistent_when_samples_share_scans() {
     let (with, without) = rms_z(runs, 21);
     println!("RMS error/σ with scan times {with:.2?}, treated as independent {without:.2?}");
     // 150 runs: the RMS of a unit normal is within ±0.1 at about 1.7σ. Measured
-    // 0.80–1.01: the unshared noise is white here, and the widening for the
+    // 0.80–1.04: the unshared noise is white here, and the widening for the
     // uncertainty of its estimate makes σ lean a little large (the model before,
     // with the lag-0 moment estimate plus one standard error: 0.77–0.97).
     for i in 0..6 {
