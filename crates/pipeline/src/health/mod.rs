@@ -85,7 +85,14 @@ pub fn check_log<'a>(log: &'a Log, opts: &Options) -> (Cow<'a, Log>, Vec<Finding
     findings.extend(spikes::repair(&mut encoders, ticks));
     findings.extend(gaps::find(&encoders, "encoder", |r| r.t, |r| r.line));
     findings.extend(gaps::find(&scans, "laser", |s| s.t, |s| s.line));
-    findings.extend(read_jitter::estimate(&encoders).and_then(|j| read_jitter::finding(&j)));
+    if let Some(j) = read_jitter::estimate(&encoders) {
+        let half =
+            read_jitter::smoothing_half_width(j.sigma_t, read_jitter::median_spacing(&encoders));
+        if j.detected() {
+            read_jitter::smooth(&mut encoders, half);
+        }
+        findings.extend(read_jitter::finding(&j, half));
+    }
 
     let changed = encoders != log.encoders || scans != log.scans.scans;
     let log = if changed {

@@ -162,8 +162,9 @@ pub fn estimate(encoders: &[EncoderRecord]) -> Option<ReadJitter> {
     })
 }
 
-/// A warning when the counts' read-time jitter is detected.
-pub fn finding(j: &ReadJitter) -> Option<Finding> {
+/// A warning when the counts' read-time jitter is detected; `half` is the
+/// smoother's half-width (records).
+pub fn finding(j: &ReadJitter, half: usize) -> Option<Finding> {
     j.detected().then(|| {
         Finding::warning(
             FindingKind::ReadJitter,
@@ -171,17 +172,106 @@ pub fn finding(j: &ReadJitter) -> Option<Finding> {
                 "the wheel counts were read at times that vary around their timestamps by \
                  about ±{:.1} ms (σ_t ≈ {:.1} ms, t = {:.0}, from the third differences of \
                  the counts over {} windows): the wheel rotations carry an error that grows \
-                 with speed, which biases the radii low and is only partly in the σ; record \
-                 the counts at the scan's time, or stamp each reading with the time it was \
-                 read",
+                 with speed, which biases the radii low; the counts were smoothed (a local \
+                 cubic in time over {} records either side) to remove most of it, and the σ \
+                 do not include what remains; record the counts at the scan's time, or \
+                 stamp each reading with the time it was read",
                 1e3 * j.sigma_t * 3f64.sqrt(),
                 1e3 * j.sigma_t,
                 j.t_stat,
-                j.windows
+                j.windows,
+                half
             ),
         )
         .count(j.windows as u64)
     })
+}
+
+/// The count at `t0` of a least-squares cubic in time through `(t, count)` points
+/// (times relative to `t0`), or `None` when the points do not determine one.
+fn cubic_at(t0: f64, pts: &[(f64, f64)]) -> Option<f64> {
+    let scale = pts
+        .iter()
+        .map(|p| (p.0 - t0).abs())
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let mut m = nalgebra::Matrix4::<f64>::zeros();
+    let mut v = nalgebra::Vector4::<f64>::zeros();
+    for &(t, y) in pts {
+        let x = (t - t0) / scale;
+        let row = nalgebra::Vector4::new(1.0, x, x * x, x * x * x);
+        m += row * row.transpose();
+        v += row * y;
+    }
+    m.cholesky().map(|c| c.solve(&v)[0])
+}
+
+/// Half-width in time (s) of the smoother at the reference jitter
+/// [`REFERENCE_SIGMA_T_S`]; see [`smoothing_half_width`].
+pub const REFERENCE_HALF_WIDTH_S: f64 = 0.4;
+/// The read-time jitter (s; ±10 ms uniform) [`REFERENCE_HALF_WIDTH_S`] was chosen at.
+pub const REFERENCE_SIGMA_T_S: f64 = 0.00577;
+
+/// Half-width (records either side) of the smoother for read-time jitter `sigma_t`
+/// (s) and records `spacing` s apart. A local cubic's error is its noise, falling as
+/// the window widens, plus the motion's fourth derivative times the window's
+/// fourth power: the best window grows as `σ_t^(2/9)`. The scale was measured on the
+/// fast-robot stand-in (motors with a 0.4 s lag, a record per 0.1 s scan): ±0.4 s at
+/// ±10 ms jitter, ±0.5 s at ±30 ms (docs/benchmarks.md).
+pub fn smoothing_half_width(sigma_t: f64, spacing: f64) -> usize {
+    let half_s = REFERENCE_HALF_WIDTH_S * (sigma_t / REFERENCE_SIGMA_T_S).powf(2.0 / 9.0);
+    let h = (half_s / spacing.max(1e-6)).round();
+    if h.is_finite() {
+        (h as usize).clamp(2, 8)
+    } else {
+        2
+    }
+}
+
+/// The median spacing of the records (s).
+pub fn median_spacing(encoders: &[EncoderRecord]) -> f64 {
+    let mut d: Vec<f64> = encoders.windows(2).map(|w| w[1].t - w[0].t).collect();
+    if d.is_empty() {
+        return 0.0;
+    }
+    let mid = d.len() / 2;
+    *d.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// Replaces each count by a local cubic in time through the `half` records either
+/// side (and itself) evaluated at its timestamp: the smooth wheel motion stays, the
+/// read-time error `ω·δt` is mostly averaged out. Records whose neighbourhood spans
+/// a gap use the records on their side of it; with fewer than five records the
+/// count is kept.
+pub fn smooth(encoders: &mut [EncoderRecord], half: usize) {
+    let n = encoders.len();
+    let orig = encoders.to_vec();
+    for j in 0..n {
+        let (lo, hi) = (j.saturating_sub(half), (j + half + 1).min(n));
+        let near: Vec<&EncoderRecord> = orig[lo..hi]
+            .iter()
+            .filter(|r| (r.t - orig[j].t).abs() <= MAX_WINDOW_S)
+            .collect();
+        if near.len() < 5 {
+            continue;
+        }
+        let base = orig[j];
+        for side in [false, true] {
+            let count = |r: &EncoderRecord| if side { r.right } else { r.left };
+            let pts: Vec<(f64, f64)> = near
+                .iter()
+                .map(|r| (r.t, count(r).wrapping_sub(count(&base)) as f64))
+                .collect();
+            if let Some(y) = cubic_at(base.t, &pts) {
+                let c = count(&base).wrapping_add(y.round() as i64);
+                if side {
+                    encoders[j].right = c;
+                } else {
+                    encoders[j].left = c;
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -217,6 +307,39 @@ mod tests {
         assert!(j.sigma_t < 5e-4, "{j:?}");
     }
 
+    /// The angle (ticks) and stamp of record `k` of [`stream`].
+    fn truth(k: usize) -> (f64, f64) {
+        let t = 0.1 * k as f64 + 0.01 * (k as f64 * 0.7).sin();
+        (t, 40_000.0 * (t - 3.0 * (t / 3.0).sin()))
+    }
+
+    #[test]
+    fn smoothing_keeps_smooth_counts_and_removes_most_jitter() {
+        let rms = |recs: &[EncoderRecord]| {
+            let s: f64 = recs
+                .iter()
+                .enumerate()
+                .map(|(k, r)| (r.left as f64 - truth(k).1.floor()).powi(2))
+                .sum();
+            (s / recs.len() as f64).sqrt()
+        };
+        let mut clean = stream(|_| 0.0);
+        smooth(&mut clean, 4);
+        assert!(rms(&clean) < 1.5, "clean counts moved: {}", rms(&clean));
+        let mut jittered = stream(|k| if k % 2 == 0 { 0.01 } else { -0.01 });
+        let before = rms(&jittered);
+        smooth(&mut jittered, 4);
+        let after = rms(&jittered);
+        assert!(after < 0.3 * before, "rms {before} → {after}");
+    }
+
+    #[test]
+    fn the_window_widens_slowly_with_the_jitter() {
+        assert_eq!(smoothing_half_width(REFERENCE_SIGMA_T_S, 0.1), 4);
+        assert_eq!(smoothing_half_width(3.0 * REFERENCE_SIGMA_T_S, 0.1), 5);
+        assert_eq!(smoothing_half_width(REFERENCE_SIGMA_T_S, 0.02), 8);
+    }
+
     #[test]
     fn jittered_counts_give_the_jitter() {
         // ±10 ms, pseudo-random, uniform: σ_t = 5.77 ms.
@@ -232,6 +355,9 @@ mod tests {
         let j = estimate(&stream(|k| deltas[k])).unwrap();
         assert!(j.detected(), "{j:?}");
         assert!((j.sigma_t - 0.00577).abs() < 0.0012, "{j:?}");
-        assert!(finding(&j).unwrap().message.contains("stamp each reading"));
+        assert!(finding(&j, 4)
+            .unwrap()
+            .message
+            .contains("stamp each reading"));
     }
 }
