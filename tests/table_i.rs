@@ -15,14 +15,13 @@
 //!   the same family-wise σ bound), and the 3σ rule measured over many seeds.
 
 use odocal_pipeline::sync::TARGET_INTERVAL_S;
-use odocal_pipeline::table_i::{
+use odocal_regression::{
     format_j_consistency, format_reproduction, format_summary, j_consistency, read_table,
     read_table_file, read_tro_reference, reproduce_from_text, reproduction_options, row_seed,
-    umbmark_j_consistency, workspace_reference_dir, workspace_table_path, JReading, PublishedRow,
-    Reproduction, Tolerances,
+    simulate_log_text, umbmark_j_consistency, workspace_reference_dir, workspace_table_path,
+    JReading, PublishedRow, Reproduction, Tolerances,
 };
-use odocal_sim::{simulate_table_row, RobotParams, SECONDS_PER_SAMPLE};
-use odocal_solver::Params;
+use odocal_sim::SECONDS_PER_SAMPLE;
 use std::process::Command;
 
 /// Largest number of samples per row in the default (quick) run.
@@ -65,21 +64,10 @@ fn published_rows() -> Vec<PublishedRow> {
     rows
 }
 
-/// A simulated Khepera III log with true parameters `truth`, sized for about
-/// `samples` pipeline samples at the default stride (as `odocal table-i`).
-fn simulate_log_text(name: &str, truth: &Params, samples: usize, seed: u64) -> Vec<u8> {
-    let robot = RobotParams {
-        r_l: truth.r_l,
-        r_r: truth.r_r,
-        b: truth.b,
-        laser: truth.laser,
-    };
-    simulate_table_row(name, &robot, samples as u64, seed).expect("the simulation runs")
-}
-
 /// Simulates `row` for `samples` samples and runs the pipeline on 2 threads.
 fn reproduce(row: &PublishedRow, samples: usize, seed: u64) -> Reproduction {
-    let text = simulate_log_text(&row.name, &row.truth(), samples, row_seed(seed, &row.name));
+    let text = simulate_log_text(&row.name, &row.truth(), samples, row_seed(seed, &row.name))
+        .expect("the simulation runs");
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()
@@ -238,7 +226,7 @@ fn fixture_is_the_reference_transcription() {
         return;
     };
     let ours = read_table(&workspace_table_path()).expect("the Table I file reads");
-    let theirs = odocal_pipeline::table_i::parse_table_document(&text, &reference)
+    let theirs = odocal_regression::parse_table_document(&text, &reference)
         .expect("the transcription reads");
     assert_eq!(ours.citation, theirs.citation);
     assert_eq!(ours.umbmark, theirs.umbmark);

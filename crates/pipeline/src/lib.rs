@@ -36,8 +36,6 @@ pub mod run;
 pub mod samples;
 pub mod sweep;
 pub mod sync;
-/// Regression against published calibration results (ICRA 2008 Table I, T-RO 2013).
-pub mod table_i;
 pub mod time_offset;
 
 pub use atomic_file::{write_atomically, write_bytes_atomically};
