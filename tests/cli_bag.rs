@@ -1,7 +1,8 @@
 //! The command line on bags: `info --json` carries the topics and the same keys as for
 //! logs; odometry-only mode without `--nominal` is refused with the flag to give, by
 //! `calibrate` and by `match`, and with it `match` writes samples that `solve`
-//! calibrates; bag flags on a Carmen log are refused.
+//! calibrates; bag flags on a Carmen log are refused; a ROS 2 bag directory calibrates
+//! from the command line with its files' checksum in the provenance.
 
 mod common;
 
@@ -32,6 +33,28 @@ fn info_json_has_topics_and_the_log_keys() {
     assert_eq!(v["rays_per_scan"], 360);
     assert!(v["duration_s"].as_f64().unwrap() > 59.0);
     assert_eq!(v["calibration_uses"]["wheels"]["left"], "wheel_left_joint");
+}
+
+#[test]
+fn a_ros2_bag_directory_calibrates_with_its_checksum() {
+    let dir = "fixtures/bags/khepera_ros2_dir";
+    let out = odocal(&["calibrate", dir, "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let sha = v["provenance"]["input_sha256"].as_str().unwrap();
+    assert!(
+        sha.len() == 64 && sha.bytes().all(|c| c.is_ascii_hexdigit()),
+        "{sha}"
+    );
+    let files: u64 = std::fs::read_dir(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(dir))
+        .unwrap()
+        .map(|e| e.unwrap().metadata().unwrap().len())
+        .sum();
+    assert_eq!(v["provenance"]["input_bytes"].as_u64(), Some(files));
 }
 
 #[test]

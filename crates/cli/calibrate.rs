@@ -6,7 +6,7 @@ use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
 use odocal_pipeline::{calibrate_log, Options, Trim};
-use odocal_report::{build_report, sha256_of_file, write_html, write_outputs, Provenance};
+use odocal_report::{build_report, sha256_of_input, write_html, write_outputs, Provenance};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -129,7 +129,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
     outcome.timing.parse = parse_s;
     let mut report = build_report(&input.read.log, &log, &opts, &outcome);
-    let (input_sha256, input_bytes) = sha256_of_file(&input.read.log)
+    let (input_sha256, input_bytes) = sha256_of_input(&input.read.log)
         .with_context(|| format!("cannot read {} for its checksum", input.read.log.display()))?;
     report.provenance = Some(Provenance {
         command_line: std::env::args().collect::<Vec<_>>().join(" "),

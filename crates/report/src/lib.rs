@@ -24,5 +24,5 @@ pub mod report;
 
 pub use odocal_pipeline::{Finding, FindingKind, Severity};
 pub use output::{html_report, write_html, write_outputs};
-pub use provenance::{sha256_of_file, Provenance};
+pub use provenance::{sha256_of_input, Provenance};
 pub use report::{build_report, Report};
