@@ -94,7 +94,7 @@ type Estimate = ([f64; 6], [[f64; 6]; 6]);
 fn check_log(label: &str, path: &Path, truth: &Truth, opts: &Options) -> Option<Estimate> {
     match checked_log(label, path, truth, opts, false) {
         Checked::Numbers(e) => Some(*e),
-        Checked::Refused | Checked::Warned => None,
+        Checked::Refused | Checked::Warned(_) => None,
     }
 }
 
@@ -105,7 +105,7 @@ enum Checked {
     /// A reasoned refusal.
     Refused,
     /// Numbers with the read-time jitter warning (allowed when `jitter_allowed`).
-    Warned,
+    Warned(Box<Estimate>),
 }
 
 fn checked_log(
@@ -127,7 +127,8 @@ fn checked_log(
                 jitter_allowed,
                 "{label}: read-time jitter found in clean counts"
             );
-            Checked::Warned
+            let c = &o.calibration;
+            Checked::Warned(Box::new((c.params.to_vector(), c.covariance)))
         }
         Ok(o) => {
             let c = &o.calibration;
@@ -184,27 +185,25 @@ fn assert_agree(seeds: (u64, u64), a: &Estimate, b: &Estimate) {
 }
 
 /// Counts read `±jitter` s around their stamp: each log warned of it (the jitter
-/// is large enough to matter), or numbers within 4σ; two logs given without the
-/// warning agree.
-fn check_jittered_pair(seeds: (u64, u64), jitter: f64) {
+/// is large enough to matter). Returns whether the two logs disagree beyond the 3σ
+/// level of χ² (their σ include the jitter left after smoothing).
+fn check_jittered_pair(seeds: (u64, u64), jitter: f64) -> bool {
     let (pa, truth) = jittered_log(seeds.0, 1.0, Some(jitter));
     let (pb, _) = jittered_log(seeds.1, 1.0, Some(jitter));
     let label = |s: u64| format!("seed {s}, counts read ±{:.0} ms", 1e3 * jitter);
     let opts = with_offset_estimate();
     let a = checked_log(&label(seeds.0), &pa, &truth, &opts, true);
     let b = checked_log(&label(seeds.1), &pb, &truth, &opts, true);
-    if let (Checked::Numbers(a), Checked::Numbers(b)) = (&a, &b) {
-        assert_agree(seeds, a, b);
-    }
-    for (s, c) in [(seeds.0, &a), (seeds.1, &b)] {
-        assert!(
-            matches!(c, Checked::Warned),
-            "{}: read-time jitter not found",
-            label(s)
-        );
-    }
     cleanup(&pa);
     cleanup(&pb);
+    match (&a, &b) {
+        (Checked::Warned(a), Checked::Warned(b)) => {
+            let (chi2, dof) = pair_chi2(a, b);
+            println!("seeds {seeds:?}: χ² {chi2:.1} for {dof} parameters");
+            dof == 0 || chi2 > CHI2_3SIGMA[dof - 1]
+        }
+        _ => panic!("seeds {seeds:?}, counts read ±{jitter} s: read-time jitter not found"),
+    }
 }
 
 /// Checks both logs of a pair with the recommended command and their agreement, and
@@ -310,11 +309,19 @@ fn counts_read_with_jitter_are_warned_of() {
 }
 
 #[test]
-#[ignore = "ten seed pairs per jitter (about 20 s on 2 cores); run by .ci/run"]
+#[ignore = "twelve seed pairs per jitter (about 30 s on 2 cores); run by .ci/run"]
 fn counts_read_with_jitter_over_seed_pairs() {
-    for k in 0..10 {
-        check_jittered_pair((1701 + 2 * k, 1702 + 2 * k), 0.01);
-        check_jittered_pair((1801 + 2 * k, 1802 + 2 * k), 0.03);
+    // Twelve pairs per jitter: at the 3σ level (0.27 %) one pair beyond is already
+    // unlikely, two mean the σ miss something (before the σ included the jitter left
+    // after smoothing: 2 of 24 pairs beyond at ±10 ms, 3 of 24 at ±30 ms).
+    for (first, jitter) in [(1701, 0.01), (1801, 0.03)] {
+        let beyond = (0..12u64)
+            .filter(|k| check_jittered_pair((first + 2 * k, first + 1 + 2 * k), jitter))
+            .count();
+        assert!(
+            beyond <= 1,
+            "counts read ±{jitter} s: {beyond} of 12 pairs disagree beyond the 3σ level of χ²"
+        );
     }
 }
 

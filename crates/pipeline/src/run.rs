@@ -137,6 +137,10 @@ pub struct Synchronized {
     /// The scans were swept and the samples were matched after moving every ray to
     /// the sensor frame at its scan's reference time (see [`crate::sweep`]).
     pub sweep_compensated: bool,
+    /// Standard deviation (s) of the read-time error left in the wheel counts after
+    /// smoothing, when they were read at jittery times (see
+    /// [`health::read_jitter`]); the solver's covariance accounts for it.
+    pub read_time_sigma: Option<f64>,
 }
 
 /// The result of [`calibrate_log`].
@@ -368,6 +372,7 @@ pub fn synchronize_and_match(
         discarded,
         time_offset: opts.time_offset,
         sweep_compensated,
+        read_time_sigma: None,
     })
 }
 
@@ -450,7 +455,10 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
     let samples: Vec<_> = synced
         .samples
         .iter()
-        .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
+        .map(|s| odocal_solver::Sample {
+            read_time_sigma: synced.read_time_sigma,
+            ..s.to_solver(opts.use_profile, opts.use_icp_covariance)
+        })
         .collect();
     let solve_options = opts.solve_options();
     let calibration = odocal_solver::calibrate(&samples, &solve_options)?;
@@ -483,10 +491,11 @@ pub fn calibrate_log(
     progress: &dyn Progress,
 ) -> Result<Outcome, PipelineError> {
     let mut timing = Timing::default();
-    let (log, mut findings) = health::check_log(log, opts);
+    let (log, mut findings, read_time_sigma) = health::check_log_and_read_times(log, opts);
     let log: &Log = &log;
     let mut synced = synchronize_and_match(log, opts, progress, &mut timing)
         .map_err(|e| PipelineError::with_faults(e, &findings))?;
+    synced.read_time_sigma = read_time_sigma;
     let found = health::clock_offset::found_offset(log, &synced, opts);
     let search_range = match (opts.estimate_time_offset, found) {
         (Some(range), _) => Some(range),

@@ -31,6 +31,7 @@ impl PairSample {
             sm: self.icp.pose,
             sm_cov: use_icp_covariance.then_some(self.icp.covariance),
             scan_times: Some([self.pair.t0, self.pair.t1]),
+            read_time_sigma: None,
             profile: use_profile.then(|| {
                 self.wheel
                     .profile
@@ -89,6 +90,7 @@ pub fn wheel_only_sample(w: &WheelMotion) -> Sample {
         sm: odocal_geom::Pose2::IDENTITY,
         sm_cov: None,
         scan_times: None,
+        read_time_sigma: None,
         profile: Some(
             w.profile
                 .iter()

@@ -20,6 +20,8 @@ pub(crate) struct Packed<'a> {
     pub profile: Option<&'a [ProfileSegment]>,
     /// Timestamps of the two scans, when known.
     pub scan_times: Option<[f64; 2]>,
+    /// Standard deviation of the read-time error of the encoder readings (s).
+    pub read_time_sigma: Option<f64>,
 }
 
 impl<'a> Packed<'a> {
@@ -31,6 +33,7 @@ impl<'a> Packed<'a> {
             sm: sample.sm.to_array(),
             index,
             scan_times: sample.scan_times,
+            read_time_sigma: sample.read_time_sigma,
             profile: if use_profile {
                 sample.profile.as_deref()
             } else {

@@ -38,6 +38,13 @@ pub struct Sample {
     /// the estimate accounts for it (see [`crate::calibrate`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scan_times: Option<[f64; 2]>,
+    /// Standard deviation (s) of the error in the times the encoder readings at the
+    /// two scans were taken, when the counts were read at jittery times (what is
+    /// left after smoothing them). Each scan's wheel angles then carry an error
+    /// `φ̇·δ` shared by the two samples that use the scan, which the covariance of
+    /// the estimate accounts for (needs `scan_times`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub read_time_sigma: Option<f64>,
 }
 
 /// Relative tolerance for a profile's rotations to add up to the sample's totals.
@@ -54,6 +61,7 @@ impl Sample {
             sm_cov: None,
             profile: None,
             scan_times: None,
+            read_time_sigma: None,
         }
     }
 
@@ -76,6 +84,7 @@ impl Sample {
             sm_cov: None,
             profile: Some(profile),
             scan_times: None,
+            read_time_sigma: None,
         }
     }
 

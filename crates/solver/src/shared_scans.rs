@@ -40,8 +40,16 @@
 //! of `Λ̂` is widened by that (see `LongRun::widened`). An earlier version used the
 //! lag-0 variance `N` at its moment estimate plus one standard error: σ 10–50 %
 //! too large on the radii, and it missed the long-range part.
+//!
+//! Wheel counts read at jittery times (`Sample::read_time_sigma`, what is left
+//! after the pipeline smoothed them) add a part to each scan's shared error that
+//! is not the same for every scan: the wheel angles at scan `j` are off by
+//! `φ̇_j·δ_j`, `δ_j` of that standard deviation, entering the sample that ends at
+//! `j` through `+F` and the one that starts there through `−F` (`F = ∂f/∂Δφ`). It
+//! is added per scan to the sandwich, and taken out of the lag-1 moments (so `D`
+//! keeps only the rest) and out of the window sums of `Λ`.
 
-use crate::kinematics::{residual_of, Predictor};
+use crate::kinematics::{residual_of, wrap_fast, Pieces as WheelPieces, Predictor};
 use crate::noise::NoiseWeights;
 use crate::packed::Packed;
 use crate::params::Params;
@@ -52,6 +60,7 @@ use std::collections::{BTreeMap, HashMap};
 type Matrix6x3 = SMatrix<f64, 6, 3>;
 type Matrix6 = SMatrix<f64, 6, 6>;
 type Matrix3x6 = SMatrix<f64, 3, 6>;
+type Vector6 = SMatrix<f64, 6, 1>;
 
 /// Fewest scans shared by two samples used for the shared-scan model to be
 /// estimated (below, the samples are treated as independent).
@@ -152,6 +161,48 @@ struct Pieces {
     b: Vec<Matrix3<f64>>,
     /// Whether sample `k + 1` starts at the scan where sample `k` ends.
     linked: Vec<bool>,
+    /// The read-time error of the counts at the start and end scans as it enters
+    /// `e_k`, per standard deviation of `δ`, when the counts were read at jittery
+    /// times.
+    read_time: Option<Vec<[Vector3<f64>; 2]>>,
+}
+
+/// `∂f/∂Δφ · φ̇ · σ` at the start scan (negated: the start's rotation error
+/// shortens the interval) and at the end scan of `s`, the wheel speeds at the
+/// scans taken from the first and last pieces; `None` without a read-time error
+/// or scan times.
+fn read_time_parts(s: &Packed, pred: &Predictor) -> Option<[Vector3<f64>; 2]> {
+    let sigma = s.read_time_sigma?;
+    let [t0, t1] = s.scan_times?;
+    let whole = t1 - t0;
+    let speed = |dl: f64, dr: f64, dt: f64| {
+        if dt > 0.0 {
+            Vector3::new(dl / dt, dr / dt, 0.0)
+        } else {
+            Vector3::zeros()
+        }
+    };
+    let (start, end) = match s.profile {
+        Some([first, .., last]) => (
+            speed(first.dphi_l, first.dphi_r, first.duration),
+            speed(last.dphi_l, last.dphi_r, last.duration),
+        ),
+        _ => {
+            let v = speed(s.dphi_l, s.dphi_r, whole);
+            (v, v)
+        }
+    };
+    // F by central differences at constant speed.
+    let h = 1e-6 * (1.0 + s.dphi_l.abs() + s.dphi_r.abs());
+    let f = |dl: f64, dr: f64| pred.predict_pieces(WheelPieces::One(Some((dl, dr))));
+    let column = |a: [f64; 3], b: [f64; 3]| {
+        Vector3::new(a[0] - b[0], a[1] - b[1], wrap_fast(a[2] - b[2])) / (2.0 * h)
+    };
+    let (l, r) = (s.dphi_l, s.dphi_r);
+    let fl = column(f(l + h, r), f(l - h, r));
+    let fr = column(f(l, r + h), f(l, r - h));
+    let effect = |v: Vector3<f64>| (fl * v[0] + fr * v[1]) * sigma;
+    Some([-effect(start), effect(end)])
 }
 
 /// `Var(Σ GᵀWe)` at `params` under the shared-scan model, with the model; `None`
@@ -179,6 +230,7 @@ pub(crate) fn score_covariance(
         linked: (0..k_all)
             .map(|k| k + 1 < k_all && times[k][1].to_bits() == times[k + 1][0].to_bits())
             .collect(),
+        read_time: samples.iter().map(|s| read_time_parts(s, &pred)).collect(),
     };
     for s in samples {
         let (pr, jac) = pred.predict_with_jacobian_pieces(s.pieces());
@@ -187,7 +239,7 @@ pub(crate) fn score_covariance(
         p.gw.push(gk.transpose() * weight(weights, s.index));
         p.g.push(gk);
     }
-    let (d, shared) = per_scan_covariance(samples, &times, &p.e)?;
+    let (d, shared) = per_scan_covariance(samples, &times, &p.e, p.read_time.as_deref())?;
     // The D part: Σ_j U_j D U_jᵀ, U_j summing GᵀWA and GᵀWB over the samples that
     // use scan j (ordered by time, so that the sums are reproducible).
     let mut per_scan: BTreeMap<u64, Matrix6x3> = BTreeMap::new();
@@ -199,9 +251,22 @@ pub(crate) fn score_covariance(
             .entry(t[1].to_bits())
             .or_insert_with(Matrix6x3::zeros) += p.gw[k] * p.a[k];
     }
-    let shared_part = per_scan
+    let mut shared_part = per_scan
         .values()
         .fold(Matrix6::zeros(), |m, u| m + u * d * u.transpose());
+    if let Some(rt) = &p.read_time {
+        let mut per_scan: BTreeMap<u64, Vector6> = BTreeMap::new();
+        for (k, t) in times.iter().enumerate() {
+            for (end, part) in rt[k].iter().enumerate() {
+                *per_scan
+                    .entry(t[end].to_bits())
+                    .or_insert_with(Vector6::zeros) += p.gw[k] * part;
+            }
+        }
+        shared_part += per_scan
+            .values()
+            .fold(Matrix6::zeros(), |m, q| m + q * q.transpose());
+    }
     let h_inv = Matrix6::from_fn(|i, j| h_inv[i][j]);
     let window = window_length(k_all);
     let long_run = long_run_covariance(&p, &d, &shared_part, &h_inv, window);
@@ -232,12 +297,13 @@ pub(crate) fn score_covariance(
 }
 
 /// `D` from the pairs of consecutive residuals, `B⁻¹ e_{k+1} e_kᵀ A⁻ᵀ` (A is a
-/// rotation), with the number of shared scans; `None` below
-/// [`MIN_SHARED_SCANS`].
+/// rotation), less the read-time error's part of `e_{k+1} e_kᵀ` when there is one,
+/// with the number of shared scans; `None` below [`MIN_SHARED_SCANS`].
 fn per_scan_covariance(
     samples: &[Packed],
     times: &[[f64; 2]],
     e: &[Vector3<f64>],
+    read_time: Option<&[[Vector3<f64>; 2]]>,
 ) -> Option<(Matrix3<f64>, usize)> {
     let starts: HashMap<u64, usize> = times
         .iter()
@@ -251,7 +317,11 @@ fn per_scan_covariance(
             continue;
         };
         let b_inv = start_map(&samples[next].sm).try_inverse()?;
-        cross += b_inv * e[next] * e[k].transpose() * end_map(&samples[k].sm);
+        let mut product = b_inv * e[next] * e[k].transpose();
+        if let Some(rt) = read_time {
+            product -= b_inv * rt[next][0] * rt[k][1].transpose();
+        }
+        cross += product * end_map(&samples[k].sm);
         shared += 1;
     }
     if shared < MIN_SHARED_SCANS {
@@ -320,10 +390,21 @@ fn long_run_covariance(
     let junction: Vec<Matrix3<f64>> = (0..k_all.saturating_sub(1))
         .map(|k| {
             let (a, b) = (p.a[k], p.b[k + 1]);
-            if p.linked[k] {
+            let scans = if p.linked[k] {
                 (a + b) * d * (a + b).transpose()
             } else {
                 a * d * a.transpose() + b * d * b.transpose()
+            };
+            match &p.read_time {
+                Some(rt) => {
+                    let (end, start) = (rt[k][1], rt[k + 1][0]);
+                    if p.linked[k] {
+                        scans + (end + start) * (end + start).transpose()
+                    } else {
+                        scans + end * end.transpose() + start * start.transpose()
+                    }
+                }
+                None => scans,
             }
         })
         .collect();
@@ -337,7 +418,11 @@ fn long_run_covariance(
     for i in 0..windows {
         let j = i + m;
         let s = sums.sum(i, j);
-        let ends = p.b[i] * d * p.b[i].transpose() + p.a[j - 1] * d * p.a[j - 1].transpose();
+        let mut ends = p.b[i] * d * p.b[i].transpose() + p.a[j - 1] * d * p.a[j - 1].transpose();
+        if let Some(rt) = &p.read_time {
+            let (start, end) = (rt[i][0], rt[j - 1][1]);
+            ends += start * start.transpose() + end * end.transpose();
+        }
         raw += s * s.transpose() - ends - inner.sum(i, j - 1);
         squares += s.component_mul(&s);
     }

@@ -54,7 +54,19 @@ fn angles_in_radians(log: &Log) -> bool {
 /// Checks the log before synchronization and repairs what is safe to repair. Returns
 /// the log to use (borrowed when nothing changed) and the findings.
 pub fn check_log<'a>(log: &'a Log, opts: &Options) -> (Cow<'a, Log>, Vec<Finding>) {
+    let (log, findings, _) = check_log_and_read_times(log, opts);
+    (log, findings)
+}
+
+/// [`check_log`], plus the standard deviation (s) of the read-time error left in
+/// the counts when they were read at jittery times and smoothed (`None` when no
+/// jitter was detected).
+pub fn check_log_and_read_times<'a>(
+    log: &'a Log,
+    opts: &Options,
+) -> (Cow<'a, Log>, Vec<Finding>, Option<f64>) {
     let mut findings = Vec::new();
+    let mut read_time_sigma = None;
     let ticks = opts
         .ticks_per_revolution
         .or(log.params.ticks_per_revolution.as_ref().map(|t| t.0));
@@ -90,6 +102,7 @@ pub fn check_log<'a>(log: &'a Log, opts: &Options) -> (Cow<'a, Log>, Vec<Finding
             read_jitter::smoothing_half_width(j.sigma_t, read_jitter::median_spacing(&encoders));
         if j.detected() {
             read_jitter::smooth(&mut encoders, half);
+            read_time_sigma = Some(read_jitter::left_after_smoothing(j.sigma_t, half));
         }
         findings.extend(read_jitter::finding(&j, half));
     }
@@ -111,7 +124,7 @@ pub fn check_log<'a>(log: &'a Log, opts: &Options) -> (Cow<'a, Log>, Vec<Finding
     } else {
         Cow::Borrowed(log)
     };
-    (log, findings)
+    (log, findings, read_time_sigma)
 }
 
 /// Checks the matched samples: a large clock offset (a quick check on every run) and

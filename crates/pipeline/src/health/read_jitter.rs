@@ -174,7 +174,7 @@ pub fn finding(j: &ReadJitter, half: usize) -> Option<Finding> {
                  the counts over {} windows): the wheel rotations carry an error that grows \
                  with speed, which biases the radii low; the counts were smoothed (a local \
                  cubic in time over {} records either side) to remove most of it, and the σ \
-                 do not include what remains; record the counts at the scan's time, or \
+                 include what remains; record the counts at the scan's time, or \
                  stamp each reading with the time it was read",
                 1e3 * j.sigma_t * 3f64.sqrt(),
                 1e3 * j.sigma_t,
@@ -226,6 +226,17 @@ pub fn smoothing_half_width(sigma_t: f64, spacing: f64) -> usize {
     } else {
         2
     }
+}
+
+/// Standard deviation (s) of the read-time error left in a count after [`smooth`]
+/// with `half`: a local cubic through `2·half + 1` equally spaced records,
+/// evaluated at the middle one, averages their errors with weights whose squares
+/// sum to `3(3h² + 3h − 1) / ((2h − 1)(2h + 1)(2h + 3))` (0.26 at `h = 4`).
+pub fn left_after_smoothing(sigma_t: f64, half: usize) -> f64 {
+    let h = half as f64;
+    let c =
+        3.0 * (3.0 * h * h + 3.0 * h - 1.0) / ((2.0 * h - 1.0) * (2.0 * h + 1.0) * (2.0 * h + 3.0));
+    sigma_t * c.sqrt()
 }
 
 /// The median spacing of the records (s).
@@ -359,5 +370,28 @@ mod tests {
             .unwrap()
             .message
             .contains("stamp each reading"));
+    }
+
+    #[test]
+    fn what_is_left_is_the_smoothers_weights() {
+        // The cubic's value at the middle is Σ w_i y_i: w_i is its value for a unit
+        // count at record i; an error of σ per record leaves σ·√Σw_i².
+        for half in 2..=8usize {
+            let n = 2 * half + 1;
+            let sum_sq: f64 = (0..n)
+                .map(|i| {
+                    let pts: Vec<(f64, f64)> = (0..n)
+                        .map(|k| (0.1 * k as f64, if k == i { 1.0 } else { 0.0 }))
+                        .collect();
+                    cubic_at(0.1 * half as f64, &pts).unwrap().powi(2)
+                })
+                .sum();
+            let got = left_after_smoothing(1.0, half);
+            assert!(
+                (got * got - sum_sq).abs() < 1e-9,
+                "h {half}: {got} vs {sum_sq}"
+            );
+        }
+        assert!((left_after_smoothing(1.0, 4).powi(2) - 0.2554).abs() < 1e-3);
     }
 }
