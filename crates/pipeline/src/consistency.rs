@@ -6,7 +6,7 @@
 //! a sensor mounting that moved), even when each half, and the whole, look fine.
 
 use nalgebra::DMatrix;
-use odocal_solver::{calibrate, Calibration, Sample, SolveOptions, PARAMETER_NAMES};
+use odocal_solver::{calibrate, Calibration, Sample, SolveOptions, Verdict, PARAMETER_NAMES};
 use serde::Serialize;
 
 /// 99.73 % quantiles of χ² with 1 … 6 degrees of freedom (the "3σ" level).
@@ -68,9 +68,47 @@ pub fn check_halves(samples: &[Sample], options: &SolveOptions) -> Consistency {
         solve(&samples[..half], "first"),
         solve(&samples[half..], "second"),
     ) {
-        (Ok(a), Ok(b)) => Consistency::Checked(Box::new(compare(&a, &b, options))),
+        (Ok(a), Ok(b)) => match undetermined_half(&a, &b, options) {
+            Some(reason) => Consistency::NotAvailable { reason },
+            None => Consistency::Checked(Box::new(compare(&a, &b, options))),
+        },
         (Err(reason), _) | (_, Err(reason)) => Consistency::NotAvailable { reason },
     }
+}
+
+/// Why the halves cannot be compared, when one of them alone does not determine
+/// every free parameter well, or the two land on different signs of the radii (the
+/// mirror solution of reversed wheels): their covariances then describe a
+/// linearization that is not valid, and χ² of the difference means nothing (on
+/// 20–60 s logs such halves gave χ² in the tens of thousands).
+fn undetermined_half(a: &Calibration, b: &Calibration, options: &SolveOptions) -> Option<String> {
+    for (half, name) in [(a, "first"), (b, "second")] {
+        let weak: Vec<&str> = half
+            .observability
+            .parameters
+            .iter()
+            .enumerate()
+            .filter(|(i, p)| {
+                !options.constraints.is_held(*i) && p.verdict != Verdict::WellDetermined
+            })
+            .map(|(_, p)| p.name.as_str())
+            .collect();
+        if !weak.is_empty() {
+            return Some(format!(
+                "the {name} half alone does not determine {} well ({} samples): the log \
+                 is too short, or its motion too uneven, for the two-halves check",
+                weak.join(", "),
+                half.samples_used
+            ));
+        }
+    }
+    let sign = |c: &Calibration| (c.params.r_l.signum(), c.params.r_r.signum());
+    (sign(a) != sign(b)).then(|| {
+        "the two halves alone land on opposite signs of the wheel radii (the mirror \
+         solution): each half is too short to tell them apart, so the two-halves check \
+         is left out"
+            .to_string()
+    })
 }
 
 fn compare(a: &Calibration, b: &Calibration, options: &SolveOptions) -> HalvesCheck {
@@ -235,6 +273,41 @@ mod tests {
             check_halves(&few, &opts),
             Consistency::NotAvailable { .. }
         ));
+    }
+
+    #[test]
+    fn a_half_that_does_not_determine_every_parameter_is_not_compared() {
+        let robot = Params {
+            r_l: 0.03,
+            r_r: 0.031,
+            b: 0.3,
+            laser: Pose2::new(0.1, 0.02, 0.5),
+        };
+        let opts = SolveOptions::default();
+        let samples = drive(&robot, &robot);
+        let solve = |part: &[Sample]| calibrate(part, &opts).expect("a half calibrates");
+        let (first, second) = (solve(&samples[..200]), solve(&samples[200..]));
+        assert_eq!(undetermined_half(&first, &second, &opts), None);
+        // A half with a weak parameter: its σ do not describe its error.
+        let mut weak = second.clone();
+        weak.observability.parameters[3].verdict = Verdict::Weak;
+        let reason = undetermined_half(&first, &weak, &opts).expect("not compared");
+        assert!(
+            reason.contains("second half")
+                && reason.contains("l_x")
+                && reason.contains("too short"),
+            "{reason}"
+        );
+        // ... unless that parameter is held.
+        let mut held = opts;
+        held.constraints.0[3] = odocal_solver::Constraint::Held(0.1);
+        assert_eq!(undetermined_half(&first, &weak, &held), None);
+        // A half on the mirror solution (reversed wheels).
+        let mut mirror = second;
+        mirror.params.r_l = -mirror.params.r_l;
+        mirror.params.r_r = -mirror.params.r_r;
+        let reason = undetermined_half(&first, &mirror, &opts).expect("not compared");
+        assert!(reason.contains("opposite signs"), "{reason}");
     }
 
     #[test]
