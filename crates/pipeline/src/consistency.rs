@@ -218,6 +218,16 @@ mod tests {
         v - v.floor() - 0.5
     }
 
+    /// The robot of the tests.
+    fn robot() -> Params {
+        Params {
+            r_l: 0.03,
+            r_r: 0.031,
+            b: 0.3,
+            laser: Pose2::new(0.1, 0.02, 0.5),
+        }
+    }
+
     /// 400 samples of a mixed drive; the second half with `second` parameters.
     fn drive(first: &Params, second: &Params) -> Vec<Sample> {
         (0..400)
@@ -238,12 +248,7 @@ mod tests {
 
     #[test]
     fn same_robot_agrees_and_a_moved_sensor_does_not() {
-        let robot = Params {
-            r_l: 0.03,
-            r_r: 0.031,
-            b: 0.3,
-            laser: Pose2::new(0.1, 0.02, 0.5),
-        };
+        let robot = robot();
         let opts = SolveOptions::default();
         let Consistency::Checked(same) = check_halves(&drive(&robot, &robot), &opts) else {
             panic!("not checked")
@@ -277,12 +282,7 @@ mod tests {
 
     #[test]
     fn a_half_that_does_not_determine_every_parameter_is_not_compared() {
-        let robot = Params {
-            r_l: 0.03,
-            r_r: 0.031,
-            b: 0.3,
-            laser: Pose2::new(0.1, 0.02, 0.5),
-        };
+        let robot = robot();
         let opts = SolveOptions::default();
         let samples = drive(&robot, &robot);
         let solve = |part: &[Sample]| calibrate(part, &opts).expect("a half calibrates");
