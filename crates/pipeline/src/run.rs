@@ -509,6 +509,12 @@ pub fn calibrate_log(
     }));
     // A swept log is matched again after compensating with the refined estimate.
     let sweep = has_sweep(&log.scans);
+    // For the solves that are never judged (before the clock offset is estimated, and
+    // the one that only compensates the sweep again): the verdicts come after.
+    let lenient = Options {
+        accept_weak: true,
+        ..opts.clone()
+    };
 
     let mut offset = None;
     if let Some(range) = search_range {
@@ -519,10 +525,6 @@ pub fn calibrate_log(
         }
         // Estimate first, on an estimate not yet judged: the verdicts come after.
         let t = Instant::now();
-        let lenient = Options {
-            accept_weak: true,
-            ..opts.clone()
-        };
         let base =
             solve(&synced, &lenient).map_err(|e| PipelineError::with_faults(e, &findings))?;
         timing.solve += t.elapsed().as_secs_f64();
@@ -540,10 +542,6 @@ pub fn calibrate_log(
     let t_solve = Instant::now();
     // With a sweep this estimate only compensates the sweep again (at the offset now
     // used): the verdicts are those of the final solve.
-    let lenient = Options {
-        accept_weak: true,
-        ..opts.clone()
-    };
     let first = if sweep { &lenient } else { opts };
     let mut calibration =
         solve(&synced, first).map_err(|e| PipelineError::with_faults(e, &findings))?;
