@@ -17,7 +17,9 @@
 //! the sensor frame at the scan's reference time), [`matching`] (ICP over the pairs, in
 //! parallel with [`parallel`]), [`health`] (data faults found, repaired and named,
 //! before and after matching, as [`finding`]s: what the results want a reader to
-//! notice), [`time_offset`] (optional clock-offset search), [`run`] (the
+//! notice), [`time_offset`] (optional clock-offset search), [`options`] (what the pipeline can be told),
+//! [`synchronized`] (the per-log samples between synchronization and the solve),
+//! [`run`] (the
 //! whole, with timing), [`samples`] (the samples and their tuples), [`estimate`] (the
 //! core numbers of a result).
 
@@ -30,12 +32,14 @@ pub mod estimate;
 pub mod finding;
 pub mod health;
 pub mod matching;
+pub mod options;
 pub mod parallel;
 mod progress;
 pub mod run;
 pub mod samples;
 pub mod sweep;
 pub mod sync;
+pub mod synchronized;
 pub mod time_offset;
 
 pub use atomic_file::{write_atomically, write_bytes_atomically};
@@ -43,6 +47,8 @@ pub use error::PipelineError;
 pub use estimate::Estimate;
 pub use finding::{Finding, FindingKind, Severity};
 pub use odocal_solver::Trim;
+pub use options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 pub use progress::{NoProgress, Progress};
-pub use run::{calibrate_log, synchronize_and_match, Options, Outcome, Synchronized, Timing};
+pub use run::{calibrate_log, synchronize_and_match, Outcome, Timing};
 pub use samples::write_tuples;
+pub use synchronized::Synchronized;

@@ -10,8 +10,9 @@
 //! the basin; golden-section search on all samples refines it.
 
 use crate::error::PipelineError;
-use crate::run::{Options, Synchronized};
+use crate::options::Options;
 use crate::sync::EncoderTrack;
+use crate::synchronized::Synchronized;
 use odocal_log::Log;
 use odocal_solver::{Calibration, Params, Predictor, Sample};
 use rayon::prelude::*;

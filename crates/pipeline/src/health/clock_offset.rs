@@ -5,8 +5,9 @@
 //! not a solve.
 
 use crate::finding::{Finding, FindingKind};
-use crate::run::{Options, Synchronized};
+use crate::options::Options;
 use crate::sync::EncoderTrack;
+use crate::synchronized::Synchronized;
 use odocal_log::Log;
 
 /// Half-width (s) of the quick check's search around the offset in use.

@@ -23,7 +23,8 @@ pub mod spikes;
 pub mod wraps;
 
 use crate::finding::Finding;
-use crate::run::{Options, Synchronized};
+use crate::options::Options;
+use crate::synchronized::Synchronized;
 use odocal_log::{
     EncoderRecord, Log, ScanMeta, ScanStore, ValueSource, WHEEL_TICKS_PER_REVOLUTION,
 };

@@ -5,7 +5,7 @@
 
 use super::since;
 use crate::finding::{Finding, FindingKind, Severity};
-use crate::run::Synchronized;
+use crate::synchronized::Synchronized;
 use odocal_log::Log;
 
 /// A sample whose rotation residual exceeds this many robust σ is flagged.

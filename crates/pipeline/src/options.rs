@@ -1,0 +1,88 @@
+//! Everything the pipeline can be told: [`Options`], shared by the per-log stages
+//! (synchronization, health, matching, clock offset) and the joint solve.
+
+use crate::sync::SyncLimits;
+use odocal_icp::IcpParams;
+use odocal_solver::{Params, SolveOptions};
+
+/// Pairs matched with identity first guesses to bootstrap the odometry guesses of
+/// the others when there are at least twice as many pairs (with fewer, all pairs are
+/// matched from identity first, and the failures again from odometry).
+pub const BOOTSTRAP_PAIRS: usize = 300;
+
+/// Fewest samples the pipeline hands to the solver.
+pub const MIN_SAMPLES: usize = 20;
+
+/// Everything the pipeline can be told.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Encoder ticks per wheel revolution; overrides the log's PARAM when set.
+    pub ticks_per_revolution: Option<f64>,
+    /// Scan pairs `stride` scans apart; `None` picks intervals of about 0.4 s.
+    pub stride: Option<usize>,
+    /// Synchronization thresholds; `None` derives them from the streams.
+    pub limits: Option<SyncLimits>,
+    /// Use the encoder profile (non-constant-speed formulas).
+    pub use_profile: bool,
+    /// Pass ŝ's covariance from ICP to the solver (weights).
+    pub use_icp_covariance: bool,
+    /// Solver settings (trimming rule, refinement).
+    pub solve: SolveOptions,
+    /// Known clock offset (s): laser clock minus encoder clock (subtracted from scan timestamps).
+    pub time_offset: f64,
+    /// Estimate the offset within ±this many seconds (`None`: keep `time_offset`,
+    /// unless [`Options::estimate_found_time_offset`] applies).
+    pub estimate_time_offset: Option<f64>,
+    /// Without [`Options::estimate_time_offset`]: when the quick check on every run
+    /// finds the clocks clearly offset from `time_offset`, estimate the offset anyway
+    /// (in a range that holds the quick check's answer) instead of calibrating at
+    /// `time_offset` with biased results. Off when the offset is known (the CLI's
+    /// `--time-offset`): then the quick check only warns.
+    pub estimate_found_time_offset: bool,
+    /// Parameters for the first guesses of scan matching (odometry prediction).
+    pub initial_params: Option<Params>,
+    /// Without `initial_params`: match [`BOOTSTRAP_PAIRS`] evenly spread pairs (all
+    /// pairs of a shorter log) with identity guesses, solve roughly, and guess the
+    /// other pairs and the failed ones by odometry with that estimate (fewer ICP
+    /// iterations and failures). Off: identity for all.
+    pub bootstrap_guesses: bool,
+    /// Match again with first guesses predicted from the first estimate.
+    pub second_pass: bool,
+    /// Scan matcher settings.
+    pub icp: IcpParams,
+    /// Return numbers even when some parameters are only weakly determined or not
+    /// excited (by default that is an error naming them), at every solve: the
+    /// first, the second pass, and each solve of the clock-offset search.
+    pub accept_weak: bool,
+}
+
+impl Options {
+    /// The solver's settings with [`Options::accept_weak`] passed on.
+    pub fn solve_options(&self) -> SolveOptions {
+        SolveOptions {
+            accept_weak: self.accept_weak || self.solve.accept_weak,
+            ..self.solve
+        }
+    }
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            ticks_per_revolution: None,
+            stride: None,
+            limits: None,
+            use_profile: true,
+            use_icp_covariance: false,
+            solve: SolveOptions::default(),
+            time_offset: 0.0,
+            estimate_time_offset: None,
+            estimate_found_time_offset: true,
+            initial_params: None,
+            bootstrap_guesses: true,
+            second_pass: false,
+            icp: IcpParams::default(),
+            accept_weak: false,
+        }
+    }
+}

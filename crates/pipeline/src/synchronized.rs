@@ -1,0 +1,32 @@
+//! The per-log data between synchronization and the solve: [`Synchronized`] (samples
+//! ready for the solver and what was thrown away), read by the health checks and the
+//! clock-offset search.
+
+use crate::samples::PairSample;
+use crate::sync::{DiscardCounts, SyncLimits};
+
+/// Samples ready for the solver, and what was thrown away.
+#[derive(Debug, Clone)]
+pub struct Synchronized {
+    /// Scans between the two of a pair.
+    pub stride: usize,
+    /// The thresholds used.
+    pub limits: SyncLimits,
+    /// Ticks per revolution used.
+    pub ticks_per_revolution: f64,
+    /// Scan pairs considered.
+    pub pairs: usize,
+    /// Pairs that became samples, in time order.
+    pub samples: Vec<PairSample>,
+    /// Pairs discarded, per reason.
+    pub discarded: DiscardCounts,
+    /// Clock offset used (s): laser clock minus encoder clock.
+    pub time_offset: f64,
+    /// The scans were swept and the samples were matched after moving every ray to
+    /// the sensor frame at its scan's reference time (see [`crate::sweep`]).
+    pub sweep_compensated: bool,
+    /// Standard deviation (s) of the read-time error left in the wheel counts after
+    /// smoothing, when they were read at jittery times (see
+    /// [`crate::health::read_jitter`]); the solver's covariance accounts for it.
+    pub read_time_sigma: Option<f64>,
+}
