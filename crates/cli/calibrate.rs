@@ -2,6 +2,7 @@
 
 use crate::input::InputArgs;
 use crate::nominal::{describe, odometry_only_mode};
+use crate::output_paths::{check_dir_output, check_file_output};
 use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
@@ -100,6 +101,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let input = &args.input;
     let pool = input.thread_pool()?;
+    if let Some(path) = &args.report {
+        check_file_output(path, &input.read.log)
+            .with_context(|| format!("cannot write the report {}", path.display()))?;
+    }
+    if let Some(dir) = &args.out {
+        check_dir_output(dir, &input.read.log)
+            .with_context(|| format!("cannot write the results into {}", dir.display()))?;
+    }
     let t_parse = Instant::now();
     let mut log = input.read_log()?;
     let parse_s = t_parse.elapsed().as_secs_f64();

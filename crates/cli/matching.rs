@@ -3,6 +3,7 @@
 
 use crate::input::InputArgs;
 use crate::nominal::{describe, odometry_only_mode};
+use crate::output_paths::check_file_output;
 use crate::progress_bar::Bar;
 use anyhow::Context;
 use odocal_pipeline::{health, synchronize_and_match, write_tuples, Options, Timing};
@@ -22,6 +23,8 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let input = &args.input;
     let pool = input.thread_pool()?;
+    check_file_output(&args.out, &input.read.log)
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
     let mut log = input.read_log()?;
     let initial_params = input.nominal()?;
     if let Some(n) = odometry_only_mode(&input.read.log, &mut log, initial_params.as_ref())? {

@@ -25,12 +25,14 @@
 
 #![deny(missing_docs)]
 
+pub mod atomic_dir;
 pub mod atomic_file;
 pub mod consistency;
 mod error;
 pub mod estimate;
 pub mod finding;
 pub mod health;
+pub mod input_files;
 pub mod matching;
 pub mod options;
 pub mod parallel;
@@ -42,10 +44,12 @@ pub mod sync;
 pub mod synchronized;
 pub mod time_offset;
 
-pub use atomic_file::{write_atomically, write_bytes_atomically};
+pub use atomic_dir::{check_replaceable_dir, write_dir_atomically};
+pub use atomic_file::{check_replaceable_file, write_atomically, write_bytes_atomically};
 pub use error::PipelineError;
 pub use estimate::Estimate;
 pub use finding::{Finding, FindingKind, Severity};
+pub use input_files::InputFiles;
 pub use odocal_solver::Trim;
 pub use options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 pub use progress::{NoProgress, Progress};

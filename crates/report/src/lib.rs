@@ -23,6 +23,6 @@ pub mod provenance;
 pub mod report;
 
 pub use odocal_pipeline::{Finding, FindingKind, Severity};
-pub use output::{html_report, write_html, write_outputs};
+pub use output::{html_report, is_output_name, write_html, write_outputs};
 pub use provenance::{sha256_of_input, Provenance};
 pub use report::{build_report, Report};

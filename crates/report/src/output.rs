@@ -4,7 +4,9 @@
 use crate::figures::{figures, Figure};
 use crate::html::page;
 use crate::report::Report;
-use odocal_pipeline::{write_bytes_atomically, write_tuples, Options, Outcome};
+use odocal_pipeline::{
+    write_bytes_atomically, write_dir_atomically, write_tuples, Options, Outcome,
+};
 use std::fs;
 use std::io;
 use std::path::Path;
@@ -34,9 +36,16 @@ pub fn write_html(
     write_bytes_atomically(path, html_report(opts, outcome, report)?.as_bytes())
 }
 
+/// True for the names of the files [`write_outputs`] writes, so an old `--out`
+/// directory holding nothing else may be replaced.
+pub fn is_output_name(name: &str) -> bool {
+    matches!(name, "results.json" | "samples.tuple" | "results.html") || name.ends_with(".svg")
+}
+
 /// Writes `results.json`, `samples.tuple`, `results.html` and, with `plots`, the
-/// figures as `NAME.svg` into `dir` (created if needed); each file atomically (a
-/// temporary file renamed).
+/// figures as `NAME.svg` as the directory `dir`, all files or none: they are written
+/// into a fresh directory that then replaces `dir` (see
+/// [`odocal_pipeline::atomic_dir`]); a `dir` holding other files is refused.
 pub fn write_outputs(
     dir: &Path,
     opts: &Options,
@@ -44,16 +53,17 @@ pub fn write_outputs(
     report: &Report,
     plots: bool,
 ) -> io::Result<()> {
-    fs::create_dir_all(dir)?;
     let json = serde_json::to_string_pretty(report).map_err(io::Error::other)?;
-    write_bytes_atomically(&dir.join("results.json"), (json + "\n").as_bytes())?;
-    write_tuples(&dir.join("samples.tuple"), &outcome.synced.samples)?;
     let figs = drawn(opts, outcome, report)?;
-    write_bytes_atomically(&dir.join("results.html"), page(report, &figs).as_bytes())?;
-    if plots {
-        for f in &figs {
-            write_bytes_atomically(&dir.join(format!("{}.svg", f.name)), f.svg.as_bytes())?;
+    write_dir_atomically(dir, &is_output_name, |fresh| {
+        write_bytes_atomically(&fresh.join("results.json"), (json + "\n").as_bytes())?;
+        write_tuples(&fresh.join("samples.tuple"), &outcome.synced.samples)?;
+        write_bytes_atomically(&fresh.join("results.html"), page(report, &figs).as_bytes())?;
+        if plots {
+            for f in &figs {
+                write_bytes_atomically(&fresh.join(format!("{}.svg", f.name)), f.svg.as_bytes())?;
+            }
         }
-    }
-    Ok(())
+        Ok(())
+    })
 }
