@@ -110,7 +110,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .with_context(|| format!("cannot write the results into {}", dir.display()))?;
     }
     let t_parse = Instant::now();
-    let mut log = input.read_log()?;
+    let (mut log, checksum) = input.read.read_log_and_checksum()?;
     let parse_s = t_parse.elapsed().as_secs_f64();
 
     let initial_params = input.nominal()?;
@@ -138,8 +138,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
     outcome.timing.parse = parse_s;
     let mut report = build_report(&input.read.log, &log, &opts, &outcome);
-    let (input_sha256, input_bytes) = sha256_of_input(&input.read.log)
-        .with_context(|| format!("cannot read {} for its checksum", input.read.log.display()))?;
+    let (input_sha256, input_bytes) = match checksum {
+        Some(c) => c,
+        None => sha256_of_input(&input.read.log).with_context(|| {
+            format!("cannot read {} for its checksum", input.read.log.display())
+        })?,
+    };
     report.provenance = Some(Provenance {
         command_line: std::env::args().collect::<Vec<_>>().join(" "),
         version: env!("CARGO_PKG_VERSION").to_string(),

@@ -13,6 +13,7 @@ mod info;
 mod input;
 mod matching;
 mod nominal;
+mod open_input;
 mod output_paths;
 mod partial_args;
 mod progress_bar;

@@ -3,16 +3,17 @@
 //! exists on every such command. The input is a Carmen/JSON log or a ROS bag (ROS 1
 //! `.bag`, ROS 2 directory, `.mcap`, `.db3`), told apart by content.
 
-use anyhow::Context;
-use odocal_bag::{detect_bag, read_bag, BagOptions, Clock, TopicChoice};
-use odocal_log::{read_log, Log, Mode, ReadOptions};
+use crate::open_input::{is_bag_file, read_text_log};
+use odocal_bag::{read_bag, BagOptions, Clock, TopicChoice};
+use odocal_log::{Log, Mode, ReadOptions};
 use std::path::PathBuf;
 
 /// The input log and the options of reading it.
 #[derive(clap::Args, Debug)]
 pub struct ReadArgs {
     /// The log: Carmen-style text, the original package's JSON log, or a ROS bag (ROS 1
-    /// .bag, ROS 2 bag directory, .mcap or .db3).
+    /// .bag, ROS 2 bag directory, .mcap or .db3). A text log may be a pipe or FIFO, or
+    /// `-` for standard input; a bag must be a file or directory.
     pub log: PathBuf,
     /// Bag: the sensor_msgs/LaserScan topic (default: the only one).
     #[arg(long, value_name = "TOPIC")]
@@ -86,16 +87,20 @@ impl ReadArgs {
         }
     }
 
-    /// True when the input is a ROS bag (by content).
+    /// True when the input is a ROS bag (by content) in a file or directory.
     pub fn is_bag(&self) -> anyhow::Result<bool> {
-        Ok(detect_bag(&self.log)
-            .with_context(|| format!("cannot open {}", self.log.display()))?
-            .is_some())
+        is_bag_file(&self.log)
     }
 
     /// Reads the log or bag, strict unless `--lenient`, with the command-line overrides.
     /// For a bag, what was chosen and why goes to stderr.
     pub fn read_log(&self) -> anyhow::Result<Log> {
+        Ok(self.read_log_and_checksum()?.0)
+    }
+
+    /// [`ReadArgs::read_log`], with the SHA-256 and size of a text log, computed on the
+    /// same single pass (`None` for a bag: see `sha256_of_input`).
+    pub fn read_log_and_checksum(&self) -> anyhow::Result<(Log, Option<(String, u64)>)> {
         if self.is_bag()? {
             if self.ticks_per_rev.is_some() || self.encoder_modulus.is_some() {
                 anyhow::bail!(
@@ -109,7 +114,7 @@ impl ReadArgs {
             for r in &bag.selection.reasons {
                 eprintln!("{r}");
             }
-            return Ok(bag.log);
+            return Ok((bag.log, None));
         }
         let bag_flags = self.scan_topic.is_some()
             || self.joint_states_topic.is_some()
@@ -123,7 +128,7 @@ impl ReadArgs {
                 self.log.display()
             );
         }
-        // The reader's message already says everything (file, line, cause).
-        read_log(&self.log, &self.read_options()).map_err(|e| anyhow::anyhow!("{e}"))
+        let (log, checksum) = read_text_log(&self.log, &self.read_options())?;
+        Ok((log, Some(checksum)))
     }
 }

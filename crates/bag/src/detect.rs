@@ -38,8 +38,13 @@ pub fn detect_bag(path: &Path) -> std::io::Result<Option<BagFormat>> {
             k => n += k,
         }
     }
-    let head = &head[..n];
-    Ok(if head.starts_with(ros1::MAGIC) {
+    Ok(bag_format_of_head(&head[..n]))
+}
+
+/// The bag format announced by the first bytes of a file (16 are enough), `None` for
+/// anything else: lets a caller that reads a stream once (a pipe) tell a bag apart.
+pub fn bag_format_of_head(head: &[u8]) -> Option<BagFormat> {
+    if head.starts_with(ros1::MAGIC) {
         Some(BagFormat::Ros1)
     } else if head.starts_with(mcap_source::MAGIC) {
         Some(BagFormat::Mcap)
@@ -50,7 +55,7 @@ pub fn detect_bag(path: &Path) -> std::io::Result<Option<BagFormat>> {
         Some(BagFormat::Ros1)
     } else {
         None
-    })
+    }
 }
 
 /// The data files of a ROS 2 bag directory in recording order: the list

@@ -28,7 +28,7 @@ mod to_log;
 mod wire;
 
 pub use collect::{Collected, DecodeFilter, TopicStats};
-pub use detect::{detect_bag, BagFormat};
+pub use detect::{bag_format_of_head, detect_bag, BagFormat};
 pub use error::BagError;
 pub use messages::{normalize_type, MessageKind, ScanFields};
 pub use select::{Selection, TopicChoice, WheelSource};

@@ -36,7 +36,7 @@ pub use line_reader::MAX_LINE_BYTES;
 pub use model::*;
 pub use options::{Mode, ReadOptions};
 pub use printable::printable;
-pub use read::{detect_format, read_log, LogFormat};
+pub use read::{detect_format, read_log, read_log_from, LogFormat};
 pub use summary::{GeometrySummary, LogSummary, SkippedLine};
 pub use tokens::MAX_COUNT;
 pub use tuple::{read_tuples, read_tuples_from, write_tuple, TupleRecord};

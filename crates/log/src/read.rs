@@ -50,11 +50,20 @@ fn refuse_binary<R: BufRead>(reader: &mut R, name: &str) -> Result<(), LogError>
 pub fn read_log(path: &Path, opts: &ReadOptions) -> Result<Log, LogError> {
     let name = path.display().to_string();
     let file = File::open(path).map_err(|e| LogError::io(&name, e))?;
-    let mut reader = BufReader::with_capacity(1 << 18, file);
-    let format = detect_format(&mut reader).map_err(|e| LogError::io(&name, e))?;
-    refuse_binary(&mut reader, &name)?;
+    read_log_from(BufReader::with_capacity(1 << 18, file), &name, opts)
+}
+
+/// Reads a log, Carmen-style text or JSON, from `reader` (a file, a pipe, standard
+/// input: it is read once, from start to end); `name` names it in messages.
+pub fn read_log_from<R: BufRead>(
+    mut reader: R,
+    name: &str,
+    opts: &ReadOptions,
+) -> Result<Log, LogError> {
+    let format = detect_format(&mut reader).map_err(|e| LogError::io(name, e))?;
+    refuse_binary(&mut reader, name)?;
     match format {
-        LogFormat::Carmen => read_carmen_from(reader, &name, opts),
-        LogFormat::Json => read_json_log_from(reader, &name, opts),
+        LogFormat::Carmen => read_carmen_from(reader, name, opts),
+        LogFormat::Json => read_json_log_from(reader, name, opts),
     }
 }

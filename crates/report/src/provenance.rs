@@ -51,27 +51,59 @@ pub fn sha256_of_input(path: &Path) -> io::Result<(String, u64)> {
     } else {
         hash_file(path, &mut hasher)?
     };
-    let hex = hasher
-        .finalize()
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect();
-    Ok((hex, bytes))
+    Ok((hex(hasher.finalize().as_slice()), bytes))
 }
 
 /// Feeds the file at `path` to `hasher`; returns its size.
 fn hash_file(path: &Path, hasher: &mut Sha256) -> io::Result<u64> {
-    let mut file = File::open(path)?;
-    let mut buf = vec![0u8; 1 << 16];
-    let mut bytes = 0u64;
-    loop {
-        let n = file.read(&mut buf)?;
-        if n == 0 {
-            return Ok(bytes);
+    let mut reader = Sha256Reader {
+        inner: File::open(path)?,
+        hasher: std::mem::take(hasher),
+        bytes: 0,
+    };
+    io::copy(&mut reader, &mut io::sink())?;
+    *hasher = reader.hasher;
+    Ok(reader.bytes)
+}
+
+/// A reader that computes the SHA-256 and size of everything read through it: the
+/// checksum of an input read once (a pipe, standard input) while it is parsed.
+pub struct Sha256Reader<R> {
+    inner: R,
+    hasher: Sha256,
+    bytes: u64,
+}
+
+impl<R: Read> Sha256Reader<R> {
+    /// Wraps `inner`.
+    pub fn new(inner: R) -> Self {
+        Sha256Reader {
+            inner,
+            hasher: Sha256::new(),
+            bytes: 0,
         }
-        hasher.update(&buf[..n]);
-        bytes += n as u64;
     }
+
+    /// Reads the rest of the input, then returns the SHA-256 (lower-case hex) and size
+    /// of all of it, as [`sha256_of_input`] gives for a file.
+    pub fn finish(mut self) -> io::Result<(String, u64)> {
+        io::copy(&mut self, &mut io::sink())?;
+        Ok((hex(self.hasher.finalize().as_slice()), self.bytes))
+    }
+}
+
+impl<R: Read> Read for Sha256Reader<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.hasher.update(&buf[..n]);
+        self.bytes += n as u64;
+        Ok(n)
+    }
+}
+
+/// `bytes` as lower-case hex.
+fn hex(bytes: &[u8]) -> String {
+    bytes.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 #[cfg(test)]
@@ -89,6 +121,18 @@ mod tests {
             hex,
             "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
         );
+    }
+
+    #[test]
+    fn a_stream_hashes_as_the_same_bytes_in_a_file() {
+        let path = std::env::temp_dir().join(format!("odocal-sha-s-{}", std::process::id()));
+        std::fs::write(&path, b"abcdef").unwrap();
+        let of_file = sha256_of_input(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        let mut r = Sha256Reader::new(&b"abcdef"[..]);
+        let mut first = [0u8; 2];
+        r.read_exact(&mut first).unwrap();
+        assert_eq!(r.finish().unwrap(), of_file);
     }
 
     #[test]
