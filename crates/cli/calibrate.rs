@@ -5,6 +5,7 @@ use crate::nominal::{describe, odometry_only_mode};
 use crate::output_paths::{check_dir_output, check_file_output};
 use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
+use crate::terminal::{out, outln, write_json_stdout};
 use anyhow::Context;
 use odocal_pipeline::{calibrate_log, Options, Trim};
 use odocal_report::{build_report, sha256_of_input, write_html, write_outputs, Provenance};
@@ -176,31 +177,27 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 }),
             );
         }
-        println!("{}", serde_json::to_string_pretty(&value)?);
+        write_json_stdout(&serde_json::to_string_pretty(&value)?)?;
     } else {
-        print!("{report}");
+        out!("{report}")?;
         if let Some(n) = &odometry_only {
-            println!(
+            outln!(
                 "{}\ncorrection factors of the nominal: r_L x{:.5}, r_R x{:.5}, b x{:.5}",
                 describe(n),
                 report.params.r_l / n.r_l,
                 report.params.r_r / n.r_r,
                 report.params.b / n.b
-            );
+            )?;
         }
     }
     match (written, &args.out) {
         (Some(Err(e)), _) => return Err(e.context("the results above were printed only")),
-        (Some(Ok(())), Some(dir)) if !args.json => {
-            println!("results written to {}", dir.display())
-        }
+        (Some(Ok(())), Some(dir)) if !args.json => outln!("results written to {}", dir.display())?,
         _ => {}
     }
     match (written_report, &args.report) {
         (Some(Err(e)), _) => return Err(e.context("the results above were printed only")),
-        (Some(Ok(())), Some(path)) if !args.json => {
-            println!("report written to {}", path.display())
-        }
+        (Some(Ok(())), Some(path)) if !args.json => outln!("report written to {}", path.display())?,
         _ => {}
     }
     Ok(())

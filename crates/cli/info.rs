@@ -6,6 +6,7 @@
 //! would use and why.
 
 use crate::read_args::ReadArgs;
+use crate::terminal::{out, outln, write_json_stdout};
 use anyhow::Context;
 use odocal_bag::inspect_bag;
 use odocal_log::LogSummary;
@@ -45,14 +46,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             );
         }
         let text = serde_json::to_string_pretty(&value).context("serializing the summary")?;
-        println!("{text}");
+        write_json_stdout(&text)?;
     } else {
-        print!("{summary}");
+        out!("{summary}")?;
         if !findings.is_empty() {
-            println!("data health (what calibrate and match do about it):");
+            outln!("data health (what calibrate and match do about it):")?;
         }
         for f in &findings {
-            println!("  {f}");
+            outln!("  {f}")?;
         }
     }
     Ok(())
@@ -100,29 +101,29 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
             };
             o.insert("warnings_bag".into(), serde_json::json!(info.warnings));
         }
-        println!("{}", serde_json::to_string_pretty(&obj)?);
+        write_json_stdout(&serde_json::to_string_pretty(&obj)?)?;
         return Ok(());
     }
-    println!(
+    outln!(
         "{} ({:?}, {:.1} MB)",
         args.read.log.display(),
         info.format,
         info.bytes_read as f64 / 1e6
-    );
-    println!("topics:");
+    )?;
+    outln!("topics:")?;
     for t in &info.topics {
         let rate = t.rate_hz().map_or("-".into(), |r| format!("{r:.1} Hz"));
-        println!(
+        outln!(
             "  {}  {}  {} messages  {rate}  {:.1} s",
             t.name,
             t.type_name,
             t.count,
             t.span_s()
-        );
+        )?;
     }
     for l in &info.lasers {
         let f = &l.fields;
-        println!(
+        outln!(
             "laser {}: {} rays, angle {:.4} to {:.4} rad step {:.6} rad, range {} to {} m, \
              time_increment {} s, scan_time {} s",
             l.topic,
@@ -134,25 +135,25 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
             f.range_max,
             f.time_increment,
             f.scan_time
-        );
+        )?;
     }
     for (t, names) in &info.joints {
-        println!("joints of {t}: {}", names.join(", "));
+        outln!("joints of {t}: {}", names.join(", "))?;
     }
     for w in &info.warnings {
-        println!("note: {w}");
+        outln!("note: {w}")?;
     }
     match choice {
         Ok(sel) => {
-            println!("calibrate would use:");
+            outln!("calibrate would use:")?;
             for r in &sel.reasons {
-                println!("  {r}");
+                outln!("  {r}")?;
             }
         }
-        Err(e) => println!("calibrate cannot choose: {e}"),
+        Err(e) => outln!("calibrate cannot choose: {e}")?,
     }
     if let Some(s) = summary {
-        print!("{s}");
+        out!("{s}")?;
     }
     Ok(())
 }

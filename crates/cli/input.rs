@@ -3,6 +3,7 @@
 
 use crate::nominal::nominal_params;
 use crate::read_args::ReadArgs;
+use crate::terminal::errln;
 use anyhow::Context;
 use odocal_log::Log;
 use odocal_solver::Params;
@@ -67,7 +68,7 @@ pub fn thread_pool(threads: Option<usize>) -> anyhow::Result<rayon::ThreadPool> 
     let cap = MAX_THREADS_PER_CORE * cores;
     let threads = match threads {
         Some(n) if n > cap => {
-            eprintln!(
+            errln!(
                 "note: --threads {n} capped at {cap} ({MAX_THREADS_PER_CORE} per core, {cores} \
                  core(s)); more threads than that only add overhead"
             );

@@ -5,6 +5,7 @@
 //! library crates (`odocal-log`, `odocal-icp`, `odocal-solver`, `odocal-sim`,
 //! `odocal-pipeline`, `odocal-report`).
 
+use crate::terminal::errln;
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
@@ -21,6 +22,7 @@ mod read_args;
 mod simulate;
 mod solve;
 mod table_i;
+mod terminal;
 
 /// Calibrate a differential-drive robot and its laser from nothing but a log.
 #[derive(Parser, Debug)]
@@ -72,7 +74,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            errln!("error: {e:#}");
             ExitCode::FAILURE
         }
     }

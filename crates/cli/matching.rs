@@ -5,6 +5,7 @@ use crate::input::InputArgs;
 use crate::nominal::{describe, odometry_only_mode};
 use crate::output_paths::check_file_output;
 use crate::progress_bar::Bar;
+use crate::terminal::errln;
 use anyhow::Context;
 use odocal_pipeline::{health, synchronize_and_match, write_tuples, Options, Timing};
 use std::path::PathBuf;
@@ -28,7 +29,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut log = input.read_log()?;
     let initial_params = input.nominal()?;
     if let Some(n) = odometry_only_mode(&input.read.log, &mut log, initial_params.as_ref())? {
-        eprintln!("{}", describe(&n));
+        errln!("{}", describe(&n));
     }
     let opts = Options {
         initial_params,
@@ -44,7 +45,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let synced = pool.install(|| synchronize_and_match(&log, &opts, &bar, &mut timing))?;
     findings.extend(health::after_matching(&log, &synced, &opts));
     for f in &findings {
-        eprintln!("{f}");
+        errln!("{f}");
     }
     write_tuples(&args.out, &synced.samples)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
@@ -54,7 +55,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .iter()
         .map(|(k, n)| format!("{k} {n}"))
         .collect();
-    eprintln!(
+    errln!(
         "{} samples written to {} ({} scan pairs, stride {}; discarded: {}); matching took {:.2} s",
         synced.samples.len(),
         args.out.display(),

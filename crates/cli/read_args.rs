@@ -4,6 +4,7 @@
 //! `.bag`, ROS 2 directory, `.mcap`, `.db3`), told apart by content.
 
 use crate::open_input::{is_bag_file, read_text_log};
+use crate::terminal::errln;
 use odocal_bag::{read_bag, BagOptions, Clock, TopicChoice};
 use odocal_log::{Log, Mode, ReadOptions};
 use std::path::PathBuf;
@@ -112,7 +113,7 @@ impl ReadArgs {
             let bag =
                 read_bag(&self.log, &self.bag_options()).map_err(|e| anyhow::anyhow!("{e}"))?;
             for r in &bag.selection.reasons {
-                eprintln!("{r}");
+                errln!("{r}");
             }
             return Ok((bag.log, None));
         }

@@ -1,6 +1,7 @@
 //! `odocal simulate`: write a simulated log (`PREFIX.log`) and its ground truth
 //! (`PREFIX.truth.json`) from a preset, with every parameter overridable.
 
+use crate::terminal::{outln, write_json_stdout};
 use anyhow::Context;
 use odocal_geom::Pose2;
 use odocal_sim::{simulate, PresetRegistry, SimConfig, TrajectoryKind};
@@ -150,7 +151,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let registry = registry(args.table.as_deref())?;
     if args.list_presets {
         for name in registry.names() {
-            println!("{name}");
+            outln!("{name}")?;
         }
         return Ok(());
     }
@@ -158,7 +159,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     apply_overrides(&mut config, &args)?;
     config.validate()?;
     if args.print_config {
-        println!("{}", serde_json::to_string_pretty(&config)?);
+        write_json_stdout(&serde_json::to_string_pretty(&config)?)?;
     }
     let Some(prefix) = args.out.as_deref() else {
         anyhow::bail!("--out PREFIX is required");
@@ -179,7 +180,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     sim.write_truth(&summary, BufWriter::new(truth_file))
         .with_context(|| format!("writing {}", truth_path.display()))?;
     let bytes = std::fs::metadata(&log_path).map(|m| m.len()).unwrap_or(0);
-    println!(
+    outln!(
         "{}: {} scans, {} encoder records, {} odom records, {} garbage lines, {:.2} MB, {:.1} s simulated in {:.2} s",
         log_path.display(),
         summary.scans,
@@ -189,8 +190,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bytes as f64 / 1e6,
         config.duration,
         started.elapsed().as_secs_f64()
-    );
-    println!("{}: ground truth", truth_path.display());
+    )?;
+    outln!("{}: ground truth", truth_path.display())?;
     Ok(())
 }
 

@@ -5,6 +5,7 @@
 
 use crate::calibrate::TrimArg;
 use crate::partial_args::PartialArgs;
+use crate::terminal::{write_json_stdout, write_stdout};
 use anyhow::Context;
 use odocal_geom::{FlatParams, Pose2};
 use odocal_log::{read_tuples, TupleRecord};
@@ -144,23 +145,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             observability: &cal.observability,
             constraints: options.constraints,
         };
-        let mut text = serde_json::to_string_pretty(&out).context("serializing the result")?;
-        text.push('\n');
-        write_stdout(&text)
+        let text = serde_json::to_string_pretty(&out).context("serializing the result")?;
+        write_json_stdout(&text)
     } else {
         write_stdout(&summary(&args, &cal, samples.len()))
-    }
-}
-
-/// Writes to standard output; a closed pipe (e.g. `| head`) is not an error.
-fn write_stdout(text: &str) -> anyhow::Result<()> {
-    use std::io::Write;
-    let mut out = std::io::stdout().lock();
-    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
-        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
-            Err(e).context("writing to standard output")
-        }
-        _ => Ok(()),
     }
 }
 

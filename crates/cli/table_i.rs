@@ -6,6 +6,7 @@
 //! the log text; print published vs recovered; optionally write `docs/table-i.md`.
 //! The work is the `odocal-regression` crate's.
 
+use crate::terminal::{errln, outln};
 use anyhow::Context;
 use odocal_regression::{
     document, format_j_consistency, format_reproduction, format_summary, j_consistency,
@@ -59,7 +60,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .unwrap_or_else(workspace_reference_dir);
     let mut sources = load_sources(args.table.as_deref(), &reference)?;
     for n in &sources.notes {
-        eprintln!("note: {n}");
+        errln!("note: {n}");
     }
     sources.select(&args.rows)?;
     let Sources { rows, table, notes } = sources;
@@ -82,22 +83,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let rep = pool
             .install(|| reproduce_from_text(row, target, &text, &opts))
             .with_context(|| format!("calibrating the simulated log of row '{}'", row.name))?;
-        println!("{}", format_reproduction(&rep, &tol));
-        println!("{}\n", timing_line(&rep, &timing));
+        outln!("{}", format_reproduction(&rep, &tol))?;
+        outln!("{}\n", timing_line(&rep, &timing))?;
         reproductions.push(rep);
         timings.push(timing);
     }
-    println!("{}", format_summary(&reproductions, &tol));
+    outln!("{}", format_summary(&reproductions, &tol))?;
     let consistency: Vec<JConsistency> = rows
         .iter()
         .filter_map(|r| j_consistency(r, J_PRINT_TOLERANCE))
         .collect();
     if !consistency.is_empty() {
-        println!("{}", format_j_consistency(&consistency, J_PRINT_TOLERANCE));
+        outln!("{}", format_j_consistency(&consistency, J_PRINT_TOLERANCE))?;
     }
     let umbmark = table.as_ref().map(|t| umbmark_section(t, &reproductions));
     if let Some(u) = &umbmark {
-        println!("{u}");
+        outln!("{u}")?;
     }
     let total = started.elapsed().as_secs_f64();
     if let Some(path) = &args.write {
@@ -120,7 +121,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             pool.current_num_threads(),
         );
         std::fs::write(path, doc).with_context(|| format!("writing {}", path.display()))?;
-        eprintln!("wrote {}", path.display());
+        errln!("wrote {}", path.display());
     }
     let failures: Vec<String> = reproductions
         .iter()

@@ -35,7 +35,7 @@ pub use json_log::read_json_log_from;
 pub use line_reader::MAX_LINE_BYTES;
 pub use model::*;
 pub use options::{Mode, ReadOptions};
-pub use printable::printable;
+pub use printable::{json_text, needs_escape, printable, terminal_text};
 pub use read::{detect_format, read_log, read_log_from, LogFormat};
 pub use summary::{GeometrySummary, LogSummary, SkippedLine};
 pub use tokens::MAX_COUNT;
