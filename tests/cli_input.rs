@@ -179,3 +179,27 @@ fn text_from_the_log_is_escaped_on_the_terminal() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn bag_topic_and_joint_names_are_escaped_on_the_terminal() {
+    let bag = fixture("fixtures/bags/hostile_names.bag");
+    let evil = "\x1b]0;pwned\x07\x1b[2J\u{202e}";
+    for args in [
+        &["info", &bag][..],
+        &["info", &bag, "--json"][..],
+        &["calibrate", &bag][..],
+    ] {
+        let out = odocal(args);
+        let shown = String::from_utf8_lossy(&out.stdout).into_owned() + &stderr(&out);
+        assert!(!shown.contains("panicked"), "{shown}");
+        assert!(shown.contains("wheel_left_joint"), "{args:?}: names shown\n{shown}");
+        for raw in ['\x1b', '\x07', '\u{202e}'] {
+            assert!(!shown.contains(raw), "{args:?}: {raw:?} printed raw\n{shown}");
+        }
+    }
+    // JSON escapes keep the names as they are in the bag.
+    let out = odocal(&["info", &bag, "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let topic = format!("/scan{evil}");
+    assert!(v["topics"].get(&topic).is_some(), "{v}");
+}
