@@ -109,6 +109,10 @@ impl ReadArgs {
             for r in &bag.selection.reasons {
                 eprintln!("{r}");
             }
+            // What `info` notes about the bag (skipped messages, no index, …).
+            for w in &bag.log.stats.warnings {
+                eprintln!("warning: {w}");
+            }
             return Ok(bag.log);
         }
         let bag_flags = self.scan_topic.is_some()

@@ -4,6 +4,7 @@
 
 use crate::collect::Collected;
 use crate::error::{BagError, TRUNCATED_FIX};
+use crate::limits::chunk_limit;
 use crate::wire::Encoding;
 use mcap::records::{op, Record};
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -31,18 +32,25 @@ fn advice(e: &McapError) -> &'static str {
             "a chunk is damaged; `mcap recover` can copy the readable chunks into a new file"
         }
         McapError::BadMagic => "the file is not an MCAP file",
+        McapError::ChunkTooLarge(_) | McapError::RecordTooLarge { .. } => {
+            "a record or decompressed chunk declares more than 64 times the file's size \
+             (16 to 256 MiB): the file is damaged or hostile; `mcap recover` can copy the \
+             readable chunks into a new file"
+        }
         _ => TRUNCATED_FIX,
     }
 }
 
-/// Reads every record of the MCAP file at `path` into `out`.
-pub(crate) fn read_mcap(path: &Path, out: &mut Collected) -> Result<(), BagError> {
-    let name = path.display().to_string();
+/// Reads every record of the MCAP file at `path` into `out`; errors name the file
+/// `name` (the compressed original when `path` is its decompressed copy).
+pub(crate) fn read_mcap(path: &Path, name: &str, out: &mut Collected) -> Result<(), BagError> {
+    let name = name.to_string();
     let mut file = File::open(path).map_err(|e| BagError::io(&name, e))?;
+    let file_len = file.metadata().map_err(|e| BagError::io(&name, e))?.len();
     out.files.push(name.clone());
     let options = LinearReaderOptions::default()
         .with_validate_chunk_crcs(true)
-        .with_record_length_limit(1 << 30);
+        .with_record_length_limit(chunk_limit(file_len) as usize);
     let mut reader = LinearReader::new_with_options(options);
     let mut schemas: HashMap<u16, (String, String)> = HashMap::new();
     let mut channels: HashMap<u16, usize> = HashMap::new();
@@ -58,7 +66,9 @@ pub(crate) fn read_mcap(path: &Path, out: &mut Collected) -> Result<(), BagError
         })?;
         match event {
             LinearReadEvent::ReadRequest(n) => {
-                let buf = reader.insert(n.max(1 << 16));
+                // Fed in blocks of at most 1 MiB: a record that declares more than the
+                // file holds allocates only what is really read.
+                let buf = reader.insert(n.clamp(1 << 16, 1 << 20));
                 let got = file.read(buf).map_err(|e| BagError::io(&name, e))?;
                 fed += got as u64;
                 reader.notify_read(got);
