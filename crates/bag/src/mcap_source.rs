@@ -6,7 +6,7 @@ use crate::collect::Collected;
 use crate::error::{BagError, TRUNCATED_FIX};
 use crate::limits::chunk_limit;
 use crate::wire::Encoding;
-use mcap::records::{op, Record};
+use mcap::records::op;
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mcap::McapError;
 use std::collections::HashMap;
@@ -41,6 +41,73 @@ fn advice(e: &McapError) -> &'static str {
     }
 }
 
+/// A little-endian cursor over one record's bytes: every read bounds-checked, strings
+/// borrowed (nothing allocated from a declared length).
+struct Fields<'a> {
+    b: &'a [u8],
+    what: &'static str,
+}
+
+impl<'a> Fields<'a> {
+    fn take(&mut self, n: usize, field: &str) -> Result<&'a [u8], String> {
+        if n > self.b.len() {
+            return Err(format!(
+                "MCAP: {} record: field `{field}` needs {n} bytes, {} remain",
+                self.what,
+                self.b.len()
+            ));
+        }
+        let (head, rest) = self.b.split_at(n);
+        self.b = rest;
+        Ok(head)
+    }
+
+    fn u16(&mut self, field: &str) -> Result<u16, String> {
+        let s = self.take(2, field)?;
+        Ok(u16::from_le_bytes([s[0], s[1]]))
+    }
+
+    fn string(&mut self, field: &str) -> Result<&'a str, String> {
+        let s = self.take(4, field)?;
+        let n = u32::from_le_bytes([s[0], s[1], s[2], s[3]]) as usize;
+        let bytes = self.take(n, field)?;
+        std::str::from_utf8(bytes)
+            .map_err(|_| format!("MCAP: {} record: field `{field}` is not UTF-8", self.what))
+    }
+}
+
+/// A schema record's id and name (the message type).
+fn schema_head(data: &[u8]) -> Result<(u16, String), String> {
+    let mut f = Fields {
+        b: data,
+        what: "schema",
+    };
+    let id = f.u16("id")?;
+    Ok((id, f.string("name")?.to_string()))
+}
+
+/// The fields of a channel record that odocal uses.
+struct ChannelHead<'a> {
+    id: u16,
+    schema_id: u16,
+    topic: &'a str,
+    message_encoding: &'a str,
+}
+
+/// A channel record's id, schema, topic and encoding (its metadata map is not read).
+fn channel_head(data: &[u8]) -> Result<ChannelHead<'_>, String> {
+    let mut f = Fields {
+        b: data,
+        what: "channel",
+    };
+    Ok(ChannelHead {
+        id: f.u16("id")?,
+        schema_id: f.u16("schema_id")?,
+        topic: f.string("topic")?,
+        message_encoding: f.string("message_encoding")?,
+    })
+}
+
 /// Reads every record of the MCAP file at `path` into `out`; errors name the file
 /// `name` (the compressed original when `path` is its decompressed copy).
 pub(crate) fn read_mcap(path: &Path, name: &str, out: &mut Collected) -> Result<(), BagError> {
@@ -52,7 +119,7 @@ pub(crate) fn read_mcap(path: &Path, name: &str, out: &mut Collected) -> Result<
         .with_validate_chunk_crcs(true)
         .with_record_length_limit(chunk_limit(file_len) as usize);
     let mut reader = LinearReader::new_with_options(options);
-    let mut schemas: HashMap<u16, (String, String)> = HashMap::new();
+    let mut schemas: HashMap<u16, String> = HashMap::new();
     let mut channels: HashMap<u16, usize> = HashMap::new();
     let mut fed: u64 = 0;
     while let Some(event) = reader.next_event() {
@@ -97,29 +164,25 @@ pub(crate) fn read_mcap(path: &Path, name: &str, out: &mut Collected) -> Result<
                     };
                     out.message(&name, i, log_time, &data[MESSAGE_HEADER..])?;
                 }
-                op::SCHEMA | op::CHANNEL => {
-                    let record = mcap::parse_record(opcode, data).map_err(|e| {
-                        BagError::format(&name, Some(fed), format!("MCAP: {e}"), advice(&e))
-                    })?;
-                    match record {
-                        Record::Schema { header, .. } => {
-                            schemas.insert(header.id, (header.name, header.encoding));
-                        }
-                        Record::Channel(c) => {
-                            let type_name = match schemas.get(&c.schema_id) {
-                                Some((n, _)) => n.clone(),
-                                None => String::from("(no schema)"),
-                            };
-                            let (encoding, type_name) = match c.message_encoding.as_str() {
-                                "cdr" => (Encoding::Cdr, type_name),
-                                "ros1" => (Encoding::Ros1, type_name),
-                                other => (Encoding::Cdr, format!("{type_name} ({other})")),
-                            };
-                            let i = out.topic(&name, &c.topic, &type_name, encoding)?;
-                            channels.insert(c.id, i);
-                        }
-                        _ => {}
-                    }
+                op::SCHEMA => {
+                    let (id, type_name) = schema_head(data)
+                        .map_err(|p| BagError::format(&name, Some(fed), p, TRUNCATED_FIX))?;
+                    schemas.insert(id, type_name);
+                }
+                op::CHANNEL => {
+                    let c = channel_head(data)
+                        .map_err(|p| BagError::format(&name, Some(fed), p, TRUNCATED_FIX))?;
+                    let type_name = match schemas.get(&c.schema_id) {
+                        Some(n) => n.clone(),
+                        None => String::from("(no schema)"),
+                    };
+                    let (encoding, type_name) = match c.message_encoding {
+                        "cdr" => (Encoding::Cdr, type_name),
+                        "ros1" => (Encoding::Ros1, type_name),
+                        other => (Encoding::Cdr, format!("{type_name} ({other})")),
+                    };
+                    let i = out.topic(&name, c.topic, &type_name, encoding)?;
+                    channels.insert(c.id, i);
                 }
                 _ => {}
             },

@@ -4,7 +4,7 @@
 //! seed. Each mutant must give `Ok` or `Err`: no panic, at most [`PEAK_BOUND`] bytes
 //! held by the reading thread, and at most [`TIME_BOUND`] per read.
 //!
-//! `ODOCAL_BAG_FUZZ_ITERS` sets the mutants per reader (default 12, a few seconds in
+//! `ODOCAL_BAG_FUZZ_ITERS` sets the mutants per reader (default 40, a few seconds in
 //! all); `ODOCAL_BAG_FUZZ_SEED` the seed. docs/hostile-input.md has the longer run.
 
 mod support;
@@ -93,7 +93,7 @@ fn read_bounded(path: &Path, what: &str) -> bool {
 
 /// Fuzzes one file of `bag` (a file, or a directory whose file `inner` is mutated).
 fn fuzz(bag: &str, inner: Option<&str>, salt: u64) {
-    let iters = env_or("ODOCAL_BAG_FUZZ_ITERS", 12);
+    let iters = env_or("ODOCAL_BAG_FUZZ_ITERS", 40);
     let mut rng = Rng(env_or("ODOCAL_BAG_FUZZ_SEED", 0x0d0c_a15e) ^ salt.wrapping_mul(0x9e37_79b9));
     let src = fixture(bag);
     let work: PathBuf = temp(&format!("fuzz-{bag}"));
