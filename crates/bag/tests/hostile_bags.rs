@@ -106,26 +106,25 @@ fn a_tiny_mcap_declaring_a_gib_record_allocates_little() {
 }
 
 #[test]
-fn an_mcap_channel_declaring_huge_metadata_allocates_little() {
-    // A channel record whose metadata map declares 3 GiB. Before: found by the fuzz
-    // loop, the record was parsed by the mcap crate, which reserved what it declared.
-    let mut channel = Vec::new();
-    channel.extend(1u16.to_le_bytes()); // id
-    channel.extend(0u16.to_le_bytes()); // schema id
-    for s in ["/scan", "cdr"] {
-        channel.extend((s.len() as u32).to_le_bytes());
-        channel.extend(s.as_bytes());
-    }
-    channel.extend(0xc000_0000u32.to_le_bytes()); // metadata: 3 GiB of pairs
-    channel.extend([0u8; 16]);
+fn an_mcap_schema_declaring_a_huge_string_allocates_little() {
+    // A schema record whose `encoding` string declares 3 GiB (found by the fuzz loop
+    // in the fixture's summary section). Before: parsed by the mcap crate, which
+    // reserved the declared length: 3.2 GiB.
+    let mut schema = Vec::new();
+    schema.extend(1u16.to_le_bytes()); // id
+    let name = "sensor_msgs/msg/LaserScan";
+    schema.extend((name.len() as u32).to_le_bytes());
+    schema.extend(name.as_bytes());
+    schema.extend(0xc000_0000u32.to_le_bytes()); // encoding: 3 GiB
+    schema.extend([0u8; 16]);
     let mut b = b"\x89MCAP0\r\n".to_vec();
-    b.push(0x04); // channel
-    b.extend((channel.len() as u64).to_le_bytes());
-    b.extend(&channel);
-    let path = write("huge-metadata.mcap", &b);
+    b.push(0x03); // schema
+    b.extend((schema.len() as u64).to_le_bytes());
+    b.extend(&schema);
+    let path = write("huge-string.mcap", &b);
     let (r, peak) = peak_of(|| scan_bag(&path, DecodeFilter::default()));
     let e = r.unwrap_err().to_string();
-    assert!(e.contains("huge-metadata.mcap"), "{e}");
+    assert!(e.contains("huge-string.mcap"), "{e}");
     assert!(peak < 32 * MIB, "peak {} MiB", peak / MIB);
     std::fs::remove_file(path).unwrap();
 }
