@@ -291,7 +291,7 @@ impl Collected {
             type_name: t.type_name.clone(),
             index,
             receive_ns,
-            error,
+            error: Box::new(error),
         };
         let kept = match kind {
             MessageKind::LaserScan => {

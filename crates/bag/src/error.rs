@@ -46,8 +46,8 @@ pub enum BagError {
         index: u64,
         /// When the bag recorded it (ns).
         receive_ns: u64,
-        /// What the decoder found.
-        error: WireError,
+        /// What the decoder found (boxed: keeps every `Result` of the reader small).
+        error: Box<WireError>,
     },
     /// Which topic or joints to use cannot be decided, or the chosen ones hold nothing
     /// usable; the text lists the candidates and the flag to choose.

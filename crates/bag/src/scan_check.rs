@@ -85,9 +85,12 @@ mod tests {
         assert_eq!(scan_problem(&fields(), 5, true), None);
     }
 
+    /// Spoils one field of a scan.
+    type Spoil = fn(&mut ScanFields);
+
     #[test]
     fn each_absurd_field_is_named() {
-        let cases: [(fn(&mut ScanFields), &str); 7] = [
+        let cases: [(Spoil, &str); 7] = [
             (|f| f.time_increment = f32::NAN, "time_increment"),
             (|f| f.time_increment = 1e6, "time_increment"),
             (|f| f.range_min = f32::INFINITY, "range_min"),

@@ -152,21 +152,20 @@ impl<'a> Wire<'a> {
         let at = self.pos;
         let n = self.u32(field)? as usize;
         let left = self.data.len() - self.pos;
+        if n.saturating_mul(min_element.max(1)) > left {
+            return Err(WireError {
+                field,
+                problem: format!(
+                    "declares {n} element(s) at offset {at} but only {left} byte(s) follow"
+                ),
+            });
+        }
         if min_element > 1 && n > MAX_SEQUENCE_LEN {
             return Err(WireError {
                 field,
                 problem: format!(
                     "declares {n} element(s) at offset {at}, more than the {MAX_SEQUENCE_LEN} \
                      a message may hold"
-                ),
-            });
-        }
-        if n.saturating_mul(min_element.max(1)) > left {
-            return Err(WireError {
-                field,
-                problem: format!(
-                    "declares {n} element(s) at offset {} but only {left} byte(s) follow",
-                    self.pos
                 ),
             });
         }

@@ -5,7 +5,7 @@
 //! held by the reading thread, and at most [`TIME_BOUND`] per read.
 //!
 //! `ODOCAL_BAG_FUZZ_ITERS` sets the mutants per reader (default 40, a few seconds in
-//! all); `ODOCAL_BAG_FUZZ_SEED` the seed. docs/hostile-input.md has the longer run.
+//! all); `ODOCAL_BAG_FUZZ_SEED` the seed. docs/bag-limits.md has the longer run.
 
 mod support;
 
