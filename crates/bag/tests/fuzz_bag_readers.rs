@@ -67,7 +67,9 @@ fn mutate(b: &mut Vec<u8>, rng: &mut Rng) {
         2 => {
             let i = rng.below(b.len().saturating_sub(4));
             let v: u32 = [0x7fff_ffff, 0xffff_ffff, 1 << 24, 1 << 28][rng.below(4)];
-            b[i..i + 4].copy_from_slice(&v.to_le_bytes());
+            if i + 4 <= b.len() {
+                b[i..i + 4].copy_from_slice(&v.to_le_bytes());
+            }
         }
         _ => {
             let i = rng.below(b.len().saturating_sub(8));
