@@ -5,6 +5,8 @@
 //! - one ROS 1 or MCAP chunk or record, decompressed: at most [`chunk_limit`] (64
 //!   times the file's size, 16 MiB to [`MAX_CHUNK_BYTES`]); one zstd-compressed
 //!   ROS 2 message: at most [`MAX_CHUNK_BYTES`];
+//! - all chunks of a file together, decompressed: at most
+//!   [`total_decompressed_limit`] (64 times the file's size, at least 1 GiB);
 //! - one message sequence (ranges, joint names, positions, …): at most
 //!   [`MAX_SEQUENCE_LEN`] elements, and never more than the bytes that follow;
 //! - everything kept from the decoded messages (ranges, joint values, odometry): at
@@ -25,6 +27,13 @@ pub const MAX_CHUNK_BYTES: u64 = 256 << 20;
 /// at most [`MAX_CHUNK_BYTES`]. A few-KB file cannot expand to hundreds of MB.
 pub fn chunk_limit(file_len: u64) -> u64 {
     file_len.saturating_mul(64).clamp(16 << 20, MAX_CHUNK_BYTES)
+}
+
+/// Most bytes all chunks of a file of `file_len` bytes may decompress to together: 64
+/// times the file's size, at least 1 GiB. Keeps the time bounded too: a file of many
+/// small decompression bombs stops after a few seconds of decompressing.
+pub fn total_decompressed_limit(file_len: u64) -> u64 {
+    file_len.saturating_mul(64).max(1 << 30)
 }
 
 /// Most bytes kept from decoded messages over the whole bag: 1 GiB (an hour of a

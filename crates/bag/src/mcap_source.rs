@@ -4,7 +4,7 @@
 
 use crate::collect::Collected;
 use crate::error::{BagError, TRUNCATED_FIX};
-use crate::limits::chunk_limit;
+use crate::limits::{chunk_limit, total_decompressed_limit};
 use crate::wire::Encoding;
 use mcap::records::op;
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
@@ -122,6 +122,7 @@ pub(crate) fn read_mcap(path: &Path, name: &str, out: &mut Collected) -> Result<
     let mut schemas: HashMap<u16, String> = HashMap::new();
     let mut channels: HashMap<u16, usize> = HashMap::new();
     let mut fed: u64 = 0;
+    let mut records_bytes: u64 = 0;
     while let Some(event) = reader.next_event() {
         let event = event.map_err(|e| {
             BagError::format(
@@ -140,52 +141,67 @@ pub(crate) fn read_mcap(path: &Path, name: &str, out: &mut Collected) -> Result<
                 fed += got as u64;
                 reader.notify_read(got);
             }
-            LinearReadEvent::Record { opcode, data } => match opcode {
-                op::MESSAGE => {
-                    let Some(head) = data.get(..MESSAGE_HEADER) else {
-                        return Err(BagError::format(
-                            &name,
-                            Some(fed),
-                            "MCAP: a message record shorter than its header",
-                            TRUNCATED_FIX,
-                        ));
-                    };
-                    let channel = u16::from_le_bytes([head[0], head[1]]);
-                    let mut t = [0u8; 8];
-                    t.copy_from_slice(&head[6..14]);
-                    let log_time = u64::from_le_bytes(t);
-                    let Some(&i) = channels.get(&channel) else {
-                        return Err(BagError::format(
-                            &name,
-                            Some(fed),
-                            format!("MCAP: a message on channel {channel} before its channel"),
-                            TRUNCATED_FIX,
-                        ));
-                    };
-                    out.message(&name, i, log_time, &data[MESSAGE_HEADER..])?;
+            LinearReadEvent::Record { opcode, data } => {
+                records_bytes += data.len() as u64;
+                if records_bytes > total_decompressed_limit(file_len) {
+                    return Err(BagError::format(
+                        &name,
+                        Some(fed),
+                        format!(
+                            "the records up to here hold {records_bytes} bytes, more than the \
+                             {} MiB a {file_len}-byte file may hold decompressed",
+                            total_decompressed_limit(file_len) >> 20
+                        ),
+                        "the file is damaged or hostile; real files compress 2 to 10 times",
+                    ));
                 }
-                op::SCHEMA => {
-                    let (id, type_name) = schema_head(data)
-                        .map_err(|p| BagError::format(&name, Some(fed), p, TRUNCATED_FIX))?;
-                    schemas.insert(id, type_name);
+                match opcode {
+                    op::MESSAGE => {
+                        let Some(head) = data.get(..MESSAGE_HEADER) else {
+                            return Err(BagError::format(
+                                &name,
+                                Some(fed),
+                                "MCAP: a message record shorter than its header",
+                                TRUNCATED_FIX,
+                            ));
+                        };
+                        let channel = u16::from_le_bytes([head[0], head[1]]);
+                        let mut t = [0u8; 8];
+                        t.copy_from_slice(&head[6..14]);
+                        let log_time = u64::from_le_bytes(t);
+                        let Some(&i) = channels.get(&channel) else {
+                            return Err(BagError::format(
+                                &name,
+                                Some(fed),
+                                format!("MCAP: a message on channel {channel} before its channel"),
+                                TRUNCATED_FIX,
+                            ));
+                        };
+                        out.message(&name, i, log_time, &data[MESSAGE_HEADER..])?;
+                    }
+                    op::SCHEMA => {
+                        let (id, type_name) = schema_head(data)
+                            .map_err(|p| BagError::format(&name, Some(fed), p, TRUNCATED_FIX))?;
+                        schemas.insert(id, type_name);
+                    }
+                    op::CHANNEL => {
+                        let c = channel_head(data)
+                            .map_err(|p| BagError::format(&name, Some(fed), p, TRUNCATED_FIX))?;
+                        let type_name = match schemas.get(&c.schema_id) {
+                            Some(n) => n.clone(),
+                            None => String::from("(no schema)"),
+                        };
+                        let (encoding, type_name) = match c.message_encoding {
+                            "cdr" => (Encoding::Cdr, type_name),
+                            "ros1" => (Encoding::Ros1, type_name),
+                            other => (Encoding::Cdr, format!("{type_name} ({other})")),
+                        };
+                        let i = out.topic(&name, c.topic, &type_name, encoding)?;
+                        channels.insert(c.id, i);
+                    }
+                    _ => {}
                 }
-                op::CHANNEL => {
-                    let c = channel_head(data)
-                        .map_err(|p| BagError::format(&name, Some(fed), p, TRUNCATED_FIX))?;
-                    let type_name = match schemas.get(&c.schema_id) {
-                        Some(n) => n.clone(),
-                        None => String::from("(no schema)"),
-                    };
-                    let (encoding, type_name) = match c.message_encoding {
-                        "cdr" => (Encoding::Cdr, type_name),
-                        "ros1" => (Encoding::Ros1, type_name),
-                        other => (Encoding::Cdr, format!("{type_name} ({other})")),
-                    };
-                    let i = out.topic(&name, c.topic, &type_name, encoding)?;
-                    channels.insert(c.id, i);
-                }
-                _ => {}
-            },
+            }
         }
     }
     out.bytes_read += fed;

@@ -9,7 +9,7 @@
 
 use crate::collect::Collected;
 use crate::error::{BagError, TRUNCATED_FIX};
-use crate::limits::chunk_limit;
+use crate::limits::{chunk_limit, total_decompressed_limit};
 use crate::wire::Encoding;
 use std::collections::HashMap;
 use std::fs::File;
@@ -232,6 +232,7 @@ pub(crate) fn read_ros1(path: &Path, out: &mut Collected) -> Result<(), BagError
     let mut data = Vec::new();
     let mut plain = Vec::new();
     let mut index_pos = None;
+    let mut decompressed = 0u64;
     while pos < file_len {
         let offset = pos;
         let header_len = read_u32(&mut f).map_err(|_| r.bad(offset, "a record cut short"))?;
@@ -277,6 +278,19 @@ pub(crate) fn read_ros1(path: &Path, out: &mut Collected) -> Result<(), BagError
                 data.resize(data_len as usize, 0);
                 f.read_exact(&mut data)
                     .map_err(|_| r.bad(offset, "a chunk cut short"))?;
+                decompressed += u64::from(size);
+                if decompressed > total_decompressed_limit(file_len) {
+                    return Err(BagError::format(
+                        &r.name,
+                        Some(offset),
+                        format!(
+                            "the chunks up to here decompress to {decompressed} bytes, more \
+                             than the {} MiB a {file_len}-byte bag may hold",
+                            total_decompressed_limit(file_len) >> 20
+                        ),
+                        "the bag is damaged or hostile; real bags compress 2 to 10 times",
+                    ));
+                }
                 if compression == "none" {
                     if data.len() != size as usize {
                         return Err(r.bad(

@@ -4,8 +4,9 @@
 //!
 //! A `.db3` is a program as much as data (views, generated columns, virtual tables
 //! run code when queried), so the file is opened read-only without URI parsing, only
-//! the two rosbag2 tables are queried and they must be plain tables, blobs are capped
-//! at [`MAX_CHUNK_BYTES`] and the queries stop after [`sqlite_time_limit`].
+//! the two rosbag2 tables are queried and they must be plain tables, blobs and
+//! SQLite's heap are capped at [`MAX_CHUNK_BYTES`] and the queries stop after
+//! [`sqlite_time_limit`].
 
 use crate::collect::Collected;
 use crate::error::BagError;
@@ -136,6 +137,9 @@ pub(crate) fn read_db3(path: &Path, name: &str, out: &mut Collected) -> Result<(
     )
     .map_err(sql)?;
     db.set_limit(Limit::SQLITE_LIMIT_LENGTH, MAX_CHUNK_BYTES as i32)
+        .map_err(sql)?;
+    // SQLite's own allocations (outside Rust's allocator) are capped as well.
+    db.pragma_update(None, "hard_heap_limit", MAX_CHUNK_BYTES as i64)
         .map_err(sql)?;
     db.progress_handler(10_000, Some(move || started.elapsed() >= limit));
     check_schema(&db).map_err(bad)?;

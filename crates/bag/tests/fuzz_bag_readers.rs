@@ -81,8 +81,9 @@ fn mutate(b: &mut Vec<u8>, rng: &mut Rng) {
     }
 }
 
-/// Reads `path` as a bag, checking the bounds; returns whether it was an error.
-fn read_bounded(path: &Path, what: &str) -> bool {
+/// Reads `path` as a bag, checking the bounds; returns whether it was an error and
+/// the most bytes held.
+fn read_bounded(path: &Path, what: &str) -> (bool, usize) {
     let started = Instant::now();
     let (r, peak) =
         peak_of(|| std::panic::catch_unwind(|| scan_bag(path, DecodeFilter::default()).is_err()));
@@ -90,7 +91,7 @@ fn read_bounded(path: &Path, what: &str) -> bool {
     let err = r.unwrap_or_else(|_| panic!("{what}: the reader panicked"));
     assert!(peak <= PEAK_BOUND, "{what}: held {} MiB", peak >> 20);
     assert!(took <= TIME_BOUND, "{what}: took {took:?}");
-    err
+    (err, peak)
 }
 
 /// Fuzzes one file of `bag` (a file, or a directory whose file `inner` is mutated).
@@ -116,18 +117,21 @@ fn fuzz(bag: &str, inner: Option<&str>, salt: u64) {
     } else {
         target.clone()
     };
-    let mut errors = 0;
+    let (mut errors, mut most) = (0, 0);
     for k in 0..iters {
         let mut b = original.clone();
         for _ in 0..1 + rng.below(2) {
             mutate(&mut b, &mut rng);
         }
         std::fs::write(&target, &b).unwrap();
-        if read_bounded(&read_path, &format!("{bag} mutant {k}")) {
-            errors += 1;
-        }
+        let (err, peak) = read_bounded(&read_path, &format!("{bag} mutant {k}"));
+        errors += usize::from(err);
+        most = most.max(peak);
     }
-    eprintln!("{bag}: {iters} mutants, {errors} refused");
+    eprintln!(
+        "{bag}: {iters} mutants, {errors} refused, at most {:.1} MiB held",
+        most as f64 / (1 << 20) as f64
+    );
     if inner.is_some() {
         std::fs::remove_dir_all(&work).unwrap();
     } else {

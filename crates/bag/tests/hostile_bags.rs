@@ -90,6 +90,31 @@ fn a_bz2_bomb_of_rays_is_refused_by_its_declared_size() {
 }
 
 #[test]
+fn many_small_bombs_stop_at_the_total_decompression_limit() {
+    // 80 chunks of 15 MiB of zeros (an uncounted topic: never decoded) in a few KB.
+    // Before: all decompressed (1.2 GB; a bag of thousands of them took hours).
+    let mut first = w::connection(0, "/blob", "std_msgs/String");
+    let message = w::message(0, 1.0, &vec![0u8; 15 << 20]);
+    first.extend(&message);
+    let mut bag = w::bag_start();
+    bag.extend(w::chunk("bz2", &first, None));
+    let next = w::chunk("bz2", &message, None);
+    drop(message);
+    for _ in 0..79 {
+        bag.extend(&next);
+    }
+    assert!(bag.len() < 100_000, "{} bytes", bag.len());
+    let path = write("many-bombs.bag", &bag);
+    let started = Instant::now();
+    let (r, peak) = peak_of(|| scan_bag(&path, DecodeFilter::default()));
+    let e = r.unwrap_err().to_string();
+    assert!(e.contains("the chunks up to here decompress to"), "{e}");
+    assert!(peak < 48 * MIB, "peak {} MiB", peak / MIB);
+    eprintln!("refused after {:?}", started.elapsed());
+    std::fs::remove_file(path).unwrap();
+}
+
+#[test]
 fn a_tiny_mcap_declaring_a_gib_record_allocates_little() {
     // Magic, then a record of opcode 0x80 declaring 1 GiB, then nothing. Before: the
     // reader's buffer was grown to the declared length (1 GiB) before reading.
