@@ -128,3 +128,29 @@ fn bag_flags_on_a_carmen_log_are_refused() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("apply to ROS bags"), "{err}");
 }
+
+#[test]
+fn calibrate_skips_a_malformed_scan_and_says_so() {
+    // The first scan of the bag declares 36 ranges where its angles make more (issue
+    // 21's 36-for-361): it is skipped and counted, and `calibrate` shows the warning
+    // that `info` shows. Before: the whole bag was refused, with --lenient too.
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/bags/khepera_ros1_plain_cw.bag");
+    let mut bytes = std::fs::read(src).unwrap();
+    let frame = b"\x05\x00\x00\x00laser";
+    let at = bytes.windows(frame.len()).position(|w| w == frame).unwrap();
+    let count = at + frame.len() + 7 * 4;
+    bytes[count..count + 4].copy_from_slice(&36u32.to_le_bytes());
+    let path = std::env::temp_dir().join(format!("odocal-cli-36-rays-{}.bag", std::process::id()));
+    std::fs::write(&path, &bytes).unwrap();
+    let out = odocal(&["calibrate", path.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(
+            "warning: topic /scan: 1 malformed scan message(s) skipped, the first (message 0"
+        ),
+        "{stderr}"
+    );
+    std::fs::remove_file(path).unwrap();
+}

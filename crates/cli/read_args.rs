@@ -115,6 +115,10 @@ impl ReadArgs {
             for r in &bag.selection.reasons {
                 errln!("{r}");
             }
+            // What `info` notes about the bag (skipped messages, no index, …).
+            for w in &bag.log.stats.warnings {
+                errln!("warning: {w}");
+            }
             return Ok((bag.log, None));
         }
         let bag_flags = self.scan_topic.is_some()

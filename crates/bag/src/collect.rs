@@ -2,11 +2,13 @@
 //! and the decoded messages of the topics that may be used (laser scans, joint states,
 //! odometry). Other topics are counted from their record headers and never decoded.
 
-use crate::error::BagError;
+use crate::error::{seconds, BagError};
+use crate::limits::MAX_DECODED_BYTES;
 use crate::messages::{
     decode_joint_state, decode_laser_scan, decode_odometry, MessageKind, OdometryMsg, ScanFields,
 };
 use crate::wire::Encoding;
+use crate::zstd_input::decompress_message;
 use std::collections::HashMap;
 
 /// One topic of a bag.
@@ -55,11 +57,38 @@ pub(crate) struct ScanRecord {
     pub(crate) len: usize,
 }
 
-/// The decoded scans of one topic.
+/// The decoded scans of one topic, and the messages that could not be decoded.
 #[derive(Debug, Default)]
 pub(crate) struct ScanTopic {
     pub(crate) records: Vec<ScanRecord>,
     pub(crate) ranges: Vec<f32>,
+    pub(crate) undecodable: Skipped,
+}
+
+/// Messages of a topic skipped because they are malformed: how many, and the first.
+#[derive(Debug, Default, Clone, PartialEq)]
+pub(crate) struct Skipped {
+    pub(crate) count: u64,
+    /// The first one: its index on the topic, receive time (ns) and what was wrong.
+    pub(crate) first: Option<(u64, u64, String)>,
+}
+
+impl Skipped {
+    /// Counts one more skipped message.
+    pub(crate) fn add(&mut self, index: u64, receive_ns: u64, why: impl FnOnce() -> String) {
+        self.count += 1;
+        if self.first.is_none() {
+            self.first = Some((index, receive_ns, why()));
+        }
+    }
+
+    /// Adds the skips of `other` (its first one is later than ours when we have one).
+    pub(crate) fn merge(&mut self, other: &Skipped) {
+        self.count += other.count;
+        if let (None, Some(f)) = (&self.first, &other.first) {
+            self.first = Some(f.clone());
+        }
+    }
 }
 
 /// One joint's values in one JointState message (NaN where not given).
@@ -133,6 +162,10 @@ pub struct Collected {
     pub bytes_read: u64,
     /// Notes worth showing once (an unindexed bag, …).
     pub warnings: Vec<String>,
+    /// Bytes kept from decoded messages, held under [`MAX_DECODED_BYTES`].
+    decoded_bytes: u64,
+    /// Each message body is a zstd frame (a ROS 2 bag of `compression_mode: MESSAGE`).
+    pub(crate) zstd_messages: bool,
 }
 
 impl Collected {
@@ -227,6 +260,29 @@ impl Collected {
         if !self.decode[i] {
             return Ok(());
         }
+        let plain;
+        let body = if self.zstd_messages {
+            plain = match decompress_message(body) {
+                Ok(p) => p,
+                Err(problem) => {
+                    let t = &self.topics[i];
+                    return Err(BagError::format(
+                        file,
+                        None,
+                        format!(
+                            "topic {}: message {index} (received at {} s): {problem}",
+                            t.name,
+                            seconds(receive_ns)
+                        ),
+                        "the bag says each message is zstd-compressed (compression_mode \
+                         MESSAGE); the message is damaged",
+                    ));
+                }
+            };
+            &plain[..]
+        } else {
+            body
+        };
         let t = &self.topics[i];
         let (kind, encoding) = (t.kind, t.encoding);
         let fail = |error| BagError::Message {
@@ -234,20 +290,31 @@ impl Collected {
             topic: t.name.clone(),
             type_name: t.type_name.clone(),
             index,
-            error,
+            receive_ns,
+            error: Box::new(error),
         };
-        match kind {
+        let kept = match kind {
             MessageKind::LaserScan => {
                 let topic = self.scans.entry(i).or_default();
                 let offset = topic.ranges.len();
-                let (fields, len) =
-                    decode_laser_scan(body, encoding, &mut topic.ranges).map_err(fail)?;
-                topic.records.push(ScanRecord {
-                    fields,
-                    receive_ns,
-                    offset,
-                    len,
-                });
+                match decode_laser_scan(body, encoding, &mut topic.ranges) {
+                    Ok((fields, len)) => {
+                        topic.records.push(ScanRecord {
+                            fields,
+                            receive_ns,
+                            offset,
+                            len,
+                        });
+                        4 * len + std::mem::size_of::<ScanRecord>()
+                    }
+                    // One damaged scan does not spoil the bag: skipped and counted.
+                    Err(e) => {
+                        topic
+                            .undecodable
+                            .add(index, receive_ns, || format!("cannot be decoded: {e}"));
+                        0
+                    }
+                }
             }
             MessageKind::JointState => {
                 let msg = decode_joint_state(body, encoding).map_err(fail)?;
@@ -260,24 +327,50 @@ impl Collected {
                         f64::NAN
                     }
                 };
-                let values = (0..n)
+                let names_before: usize = topic.names.len();
+                let values: Vec<JointValue> = (0..n)
                     .map(|k| JointValue {
                         joint: topic.intern(msg.names[k]),
                         position: given(&msg.position, k),
                         velocity: given(&msg.velocity, k),
                     })
                     .collect();
+                let new_names: usize = topic.names[names_before..]
+                    .iter()
+                    .map(|s| 2 * s.len() + 64)
+                    .sum();
                 topic.records.push(JointRecord {
                     stamp_ns: msg.stamp_ns,
                     receive_ns,
                     values,
                 });
+                n * std::mem::size_of::<JointValue>()
+                    + std::mem::size_of::<JointRecord>()
+                    + new_names
             }
             MessageKind::Odometry => {
                 let msg = decode_odometry(body, encoding).map_err(fail)?;
                 self.odom.entry(i).or_default().push((msg, receive_ns));
+                std::mem::size_of::<(OdometryMsg, u64)>()
             }
-            MessageKind::Other => {}
+            MessageKind::Other => 0,
+        };
+        self.decoded_bytes += kept as u64;
+        if self.decoded_bytes > MAX_DECODED_BYTES {
+            let t = &self.topics[i];
+            return Err(BagError::format(
+                file,
+                None,
+                format!(
+                    "the decoded messages exceed the memory budget of {} MiB at message {index} \
+                     of topic {} (received at {} s)",
+                    MAX_DECODED_BYTES >> 20,
+                    t.name,
+                    seconds(receive_ns)
+                ),
+                "name the topics to use (--scan-topic, --joint-states-topic, --odom-topic) so \
+                 that fewer are decoded, or cut the bag into shorter parts with the ROS tools",
+            ));
         }
         Ok(())
     }

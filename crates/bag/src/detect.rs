@@ -1,10 +1,9 @@
 //! Which kind of bag a path is, by content: the first bytes of a file (ROS 1 `#ROSBAG
 //! V2.0`, MCAP magic, SQLite header) or a ROS 2 bag directory (`metadata.yaml`).
 
-use crate::error::BagError;
 use crate::{mcap_source, ros1, sqlite_source};
 use std::io::Read;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The bag formats this crate reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -56,70 +55,4 @@ pub fn bag_format_of_head(head: &[u8]) -> Option<BagFormat> {
     } else {
         None
     }
-}
-
-/// The data files of a ROS 2 bag directory in recording order: the list
-/// `relative_file_paths` of metadata.yaml.
-pub(crate) fn ros2_files(dir: &Path) -> Result<Vec<PathBuf>, BagError> {
-    let meta = dir.join("metadata.yaml");
-    let name = meta.display().to_string();
-    let text = std::fs::read_to_string(&meta).map_err(|e| BagError::io(&name, e))?;
-    let mut files = Vec::new();
-    let mut in_list: Option<usize> = None;
-    let mut compression = String::new();
-    for line in text.lines() {
-        let indent = line.len() - line.trim_start().len();
-        let t = line.trim();
-        if let Some(key_indent) = in_list {
-            if let Some(item) = t.strip_prefix("- ") {
-                if indent >= key_indent {
-                    files.push(dir.join(unquote(item)));
-                    continue;
-                }
-            }
-            if !t.is_empty() {
-                in_list = None;
-            }
-        }
-        if t == "relative_file_paths:" {
-            in_list = Some(indent);
-        } else if let Some(v) = t.strip_prefix("compression_mode:") {
-            compression = unquote(v.trim()).to_string();
-        }
-    }
-    if !compression.is_empty() && compression != "NONE" {
-        return Err(BagError::format(
-            &name,
-            None,
-            format!("the bag's files are compressed as a whole (compression_mode {compression})"),
-            "decompress it first (`ros2 bag decompress`) and read the result",
-        ));
-    }
-    if files.is_empty() {
-        return Err(BagError::format(
-            &name,
-            None,
-            "metadata.yaml lists no files (no `relative_file_paths`)",
-            "check that the directory is a complete ROS 2 bag (`ros2 bag info`)",
-        ));
-    }
-    for f in &files {
-        if !f.is_file() {
-            return Err(BagError::format(
-                &name,
-                None,
-                format!("metadata.yaml lists {} which does not exist", f.display()),
-                "copy the whole bag directory, every split file included",
-            ));
-        }
-    }
-    Ok(files)
-}
-
-fn unquote(s: &str) -> &str {
-    let s = s.trim();
-    s.strip_prefix('"')
-        .and_then(|s| s.strip_suffix('"'))
-        .or_else(|| s.strip_prefix('\'').and_then(|s| s.strip_suffix('\'')))
-        .unwrap_or(s)
 }

@@ -29,9 +29,11 @@ pub enum BagError {
     },
     /// A message on a topic that is used cannot be decoded.
     #[error(
-        "{file}: topic {topic} ({type_name}): message {index} cannot be decoded: {error}; \
+        "{file}: topic {topic} ({type_name}): message {index} (received at {} s) cannot be \
+         decoded: {error}; \
          the bag is damaged or the topic does not carry the type it declares — choose \
-         another topic or repair the bag"
+         another topic or repair the bag",
+        seconds(*.receive_ns)
     )]
     Message {
         /// The file.
@@ -42,8 +44,10 @@ pub enum BagError {
         type_name: String,
         /// 0-based index of the message on the topic.
         index: u64,
-        /// What the decoder found.
-        error: WireError,
+        /// When the bag recorded it (ns).
+        receive_ns: u64,
+        /// What the decoder found (boxed: keeps every `Result` of the reader small).
+        error: Box<WireError>,
     },
     /// Which topic or joints to use cannot be decided, or the chosen ones hold nothing
     /// usable; the text lists the candidates and the flag to choose.
@@ -54,6 +58,11 @@ pub enum BagError {
         /// The explanation, with every candidate.
         message: String,
     },
+}
+
+/// A time in nanoseconds as exact seconds (`12.000000500`).
+pub(crate) fn seconds(ns: u64) -> String {
+    format!("{}.{:09}", ns / 1_000_000_000, ns % 1_000_000_000)
 }
 
 fn at_offset(offset: Option<u64>) -> String {

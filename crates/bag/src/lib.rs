@@ -19,13 +19,17 @@
 mod collect;
 mod detect;
 mod error;
+pub mod limits;
 mod mcap_source;
 mod messages;
+mod metadata;
 mod ros1;
+mod scan_check;
 mod select;
 mod sqlite_source;
 mod to_log;
 mod wire;
+mod zstd_input;
 
 pub use collect::{Collected, DecodeFilter, TopicStats};
 pub use detect::{bag_format_of_head, detect_bag, BagFormat};
@@ -83,14 +87,22 @@ pub fn scan_bag(path: &Path, filter: DecodeFilter) -> Result<(BagFormat, Collect
     let mut out = Collected::new(filter);
     match format {
         BagFormat::Ros1 => ros1::read_ros1(path, &mut out)?,
-        BagFormat::Mcap => mcap_source::read_mcap(path, &mut out)?,
-        BagFormat::Db3 => sqlite_source::read_db3(path, &mut out)?,
+        BagFormat::Mcap => mcap_source::read_mcap(path, &name, &mut out)?,
+        BagFormat::Db3 => sqlite_source::read_db3(path, &name, &mut out)?,
         BagFormat::Ros2Directory => {
-            for file in detect::ros2_files(path)? {
+            let meta = metadata::read_metadata(path)?;
+            out.zstd_messages = meta.compression == metadata::Compression::Message;
+            for file in &meta.files {
                 let fname = file.display().to_string();
-                match detect_bag(&file).map_err(|e| BagError::io(&fname, e))? {
-                    Some(BagFormat::Mcap) => mcap_source::read_mcap(&file, &mut out)?,
-                    Some(BagFormat::Db3) => sqlite_source::read_db3(&file, &mut out)?,
+                // A FILE-compressed bag is read from a decompressed temporary copy.
+                let copy = match meta.compression {
+                    metadata::Compression::File => Some(zstd_input::decompress_file(file)?),
+                    _ => None,
+                };
+                let readable = copy.as_ref().map_or(file.as_path(), |c| c.path.as_path());
+                match detect_bag(readable).map_err(|e| BagError::io(&fname, e))? {
+                    Some(BagFormat::Mcap) => mcap_source::read_mcap(readable, &fname, &mut out)?,
+                    Some(BagFormat::Db3) => sqlite_source::read_db3(readable, &fname, &mut out)?,
                     _ => {
                         return Err(BagError::format(
                             &fname,

@@ -9,6 +9,7 @@
 
 use crate::collect::Collected;
 use crate::error::{BagError, TRUNCATED_FIX};
+use crate::limits::{chunk_limit, total_decompressed_limit};
 use crate::wire::Encoding;
 use std::collections::HashMap;
 use std::fs::File;
@@ -28,9 +29,6 @@ const OP_CONNECTION: u8 = 0x07;
 /// Largest record header accepted (headers are a few fields; the message definition
 /// lives in the data).
 const MAX_HEADER: u32 = 1 << 20;
-/// Largest uncompressed chunk accepted (rosbag's default chunk is 768 KiB; a chunk
-/// holding one large image can be tens of MB).
-const MAX_CHUNK: u32 = 1 << 30;
 
 /// The fields of a record header.
 struct Fields<'a>(Vec<(&'a str, &'a [u8])>);
@@ -182,7 +180,8 @@ fn decompress(
     out: &mut Vec<u8>,
 ) -> Result<(), String> {
     out.clear();
-    out.reserve(size);
+    // Grown as the data really decompresses, not as the header declares.
+    out.reserve(size.min(data.len().saturating_mul(8)));
     let limit = size as u64 + 1;
     let got = match compression {
         "bz2" => bzip2::read::BzDecoder::new(data)
@@ -213,9 +212,8 @@ pub(crate) fn read_ros1(path: &Path, out: &mut Collected) -> Result<(), BagError
     let file_len = file.metadata().map_err(|e| BagError::io(&name, e))?.len();
     let mut f = BufReader::with_capacity(1 << 16, file);
     let mut magic = [0u8; 13];
-    f.read_exact(&mut magic)
-        .map_err(|e| BagError::io(&name, e))?;
-    if magic != MAGIC {
+    let whole = f.read_exact(&mut magic).is_ok();
+    if !whole || magic != MAGIC {
         return Err(BagError::format(
             &name,
             Some(0),
@@ -234,6 +232,7 @@ pub(crate) fn read_ros1(path: &Path, out: &mut Collected) -> Result<(), BagError
     let mut data = Vec::new();
     let mut plain = Vec::new();
     let mut index_pos = None;
+    let mut decompressed = 0u64;
     while pos < file_len {
         let offset = pos;
         let header_len = read_u32(&mut f).map_err(|_| r.bad(offset, "a record cut short"))?;
@@ -263,12 +262,35 @@ pub(crate) fn read_ros1(path: &Path, out: &mut Collected) -> Result<(), BagError
             OP_CHUNK => {
                 let compression = fields.text("compression").map_err(|p| r.bad(offset, p))?;
                 let size = fields.u32("size").map_err(|p| r.bad(offset, p))?;
-                if size > MAX_CHUNK {
-                    return Err(r.bad(offset, format!("a chunk claims {size} bytes")));
+                if u64::from(size) > chunk_limit(file_len) {
+                    return Err(BagError::format(
+                        &r.name,
+                        Some(offset),
+                        format!(
+                            "a chunk declares {size} bytes decompressed, more than the {} MiB \
+                             a chunk of a {file_len}-byte bag may hold",
+                            chunk_limit(file_len) >> 20
+                        ),
+                        "the bag is damaged or hostile; real chunks are a few MB (rosbag's \
+                         default is 768 KiB)",
+                    ));
                 }
                 data.resize(data_len as usize, 0);
                 f.read_exact(&mut data)
                     .map_err(|_| r.bad(offset, "a chunk cut short"))?;
+                decompressed += u64::from(size);
+                if decompressed > total_decompressed_limit(file_len) {
+                    return Err(BagError::format(
+                        &r.name,
+                        Some(offset),
+                        format!(
+                            "the chunks up to here decompress to {decompressed} bytes, more \
+                             than the {} MiB a {file_len}-byte bag may hold",
+                            total_decompressed_limit(file_len) >> 20
+                        ),
+                        "the bag is damaged or hostile; real bags compress 2 to 10 times",
+                    ));
+                }
                 if compression == "none" {
                     if data.len() != size as usize {
                         return Err(r.bad(

@@ -2,8 +2,9 @@
 //! into: scans with their geometry (sweep timing kept), wheel angles as encoder
 //! records at [`WHEEL_TICKS_PER_REVOLUTION`], odometry poses as `ODOM` records.
 
-use crate::collect::{Collected, JointRecord, ScanRecord};
-use crate::error::BagError;
+use crate::collect::{Collected, JointRecord, ScanRecord, Skipped};
+use crate::error::{self, BagError};
+use crate::scan_check::scan_problem;
 use crate::select::{Selection, WheelSource};
 use odocal_log::{
     ticks_of_angle, EncoderRecord, LaserFields, Log, OdomRecord, ReadOptions, ScanGeometry,
@@ -58,33 +59,6 @@ fn same_fields(a: &ScanRecord, b: &ScanRecord) -> bool {
         && x.range_max.to_bits() == y.range_max.to_bits()
 }
 
-/// Checks a scan's declared geometry: finite, nonzero increment, ray count matching
-/// the angle span (within one ray), positive maximum range.
-fn check_geometry(file: &str, topic: &str, index: usize, rec: &ScanRecord) -> Result<(), BagError> {
-    let f = &rec.fields;
-    let finite = [f.angle_min, f.angle_max, f.angle_increment, f.range_max]
-        .iter()
-        .all(|v| v.is_finite());
-    let span_rays = if f.angle_increment != 0.0 {
-        ((f.angle_max - f.angle_min) / f.angle_increment) as f64 + 1.0
-    } else {
-        f64::NAN
-    };
-    let fits = (span_rays - rec.len as f64).abs() <= 1.5;
-    if finite && f.angle_increment != 0.0 && f.range_max > 0.0 && rec.len >= 2 && fits {
-        return Ok(());
-    }
-    Err(BagError::choice(
-        file,
-        format!(
-            "topic {topic}: scan {index} declares angle_min {}, angle_max {}, angle_increment \
-             {}, range_max {} and has {} ranges, which do not describe a usable scan; choose \
-             another topic with --scan-topic",
-            f.angle_min, f.angle_max, f.angle_increment, f.range_max, rec.len
-        ),
-    ))
-}
-
 /// Time (s), wheel positions (rad) and wheel velocities (rad/s), left and right.
 type WheelSample = (f64, (f64, f64), (f64, f64));
 
@@ -118,12 +92,20 @@ pub(crate) fn build_log(
         ));
     };
     let topic = &c.scans[&scan_i];
+    let own_time_increment = opts.time_increment.is_none();
+    let mut skipped = topic.undecodable.clone();
     let mut last: Option<(&ScanRecord, ScanGeometry)> = None;
+    let mut used = 0u64;
     for (k, rec) in topic.records.iter().enumerate() {
         let g = match &last {
             Some((prev, g)) if same_fields(prev, rec) => g.clone(),
             _ => {
-                check_geometry(file, &sel.scan_topic, k, rec)?;
+                if let Some(why) = scan_problem(&rec.fields, rec.len, own_time_increment) {
+                    let mut bad = Skipped::default();
+                    bad.add(k as u64, rec.receive_ns, || why);
+                    skipped.merge(&bad);
+                    continue;
+                }
                 geometry(rec, opts)
             }
         };
@@ -131,12 +113,26 @@ pub(crate) fn build_log(
         let ranges = &topic.ranges[rec.offset..rec.offset + rec.len];
         log.scans
             .push(t, &g, ranges, ScanKind::LaserScan, k as u64 + 1);
+        used += 1;
         last = Some((rec, g));
     }
-    messages.insert(
-        format!("LaserScan {}", sel.scan_topic),
-        topic.records.len() as u64,
-    );
+    if let Some((index, receive_ns, why)) = &skipped.first {
+        let text = format!(
+            "topic {}: {} malformed scan message(s) skipped, the first (message {index}, \
+             received at {} s): {why}",
+            sel.scan_topic,
+            skipped.count,
+            error::seconds(*receive_ns)
+        );
+        if used == 0 {
+            return Err(BagError::choice(
+                file,
+                format!("{text}; no usable scan remains: choose another topic with --scan-topic"),
+            ));
+        }
+        log.stats.warnings.push(text);
+    }
+    messages.insert(format!("LaserScan {}", sel.scan_topic), used);
     if let Some(g) = log.scans.geometries.first() {
         log.params.laser_min_range = g.min_range;
         log.params.laser_time_increment = Some(g.time_increment);

@@ -4,6 +4,8 @@
 //! Every read checks the remaining length; a short or inconsistent body is an error
 //! naming the field, never a panic.
 
+use crate::limits::MAX_SEQUENCE_LEN;
+
 /// How a message body is serialized.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -144,16 +146,26 @@ impl<'a> Wire<'a> {
     }
 
     /// A sequence length, checked against the bytes left (each element takes at least
-    /// `min_element` bytes), so a corrupt length cannot ask for a huge allocation.
+    /// `min_element` bytes) and against [`MAX_SEQUENCE_LEN`], so a corrupt length cannot
+    /// ask for a huge allocation.
     fn length(&mut self, field: &'static str, min_element: usize) -> Result<usize, WireError> {
+        let at = self.pos;
         let n = self.u32(field)? as usize;
         let left = self.data.len() - self.pos;
         if n.saturating_mul(min_element.max(1)) > left {
             return Err(WireError {
                 field,
                 problem: format!(
-                    "declares {n} element(s) at offset {} but only {left} byte(s) follow",
-                    self.pos
+                    "declares {n} element(s) at offset {at} but only {left} byte(s) follow"
+                ),
+            });
+        }
+        if min_element > 1 && n > MAX_SEQUENCE_LEN {
+            return Err(WireError {
+                field,
+                problem: format!(
+                    "declares {n} element(s) at offset {at}, more than the {MAX_SEQUENCE_LEN} \
+                     a message may hold"
                 ),
             });
         }
@@ -287,5 +299,16 @@ mod tests {
         let mut w = Wire::new(&b, Encoding::Ros1).unwrap();
         let err = w.f64_seq("position").unwrap_err();
         assert_eq!(err.field, "position");
+    }
+
+    #[test]
+    fn a_sequence_longer_than_the_cap_is_refused_even_when_its_bytes_are_there() {
+        let n = MAX_SEQUENCE_LEN + 1;
+        let mut b = Vec::with_capacity(4 + 4 * n);
+        b.extend((n as u32).to_le_bytes());
+        b.resize(4 + 4 * n, 0);
+        let mut w = Wire::new(&b, Encoding::Ros1).unwrap();
+        let err = w.strings("name").unwrap_err();
+        assert!(err.problem.contains("more than"), "{err}");
     }
 }
