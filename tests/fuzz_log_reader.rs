@@ -5,16 +5,30 @@
 //! JSON logs. Every input must give
 //! `Ok` or an error — never a panic — in strict and in lenient mode; whatever reads
 //! is then pushed through the whole pipeline, which must also answer without panic.
+//! The hostile data of issue 22 (timestamps in ms/µs/ns or up to 1e300, counts scaled
+//! by up to 1e12 or offset beyond 2^53) are among the edits, and properties check that
+//! implausible timestamps and counts are refused by name.
+//!
+//! `cargo test` runs 300 cases per property (a few seconds); a longer run:
+//! `ODOCAL_FUZZ_CASES=20000 cargo test --release --test fuzz_log_reader`.
 
 mod common;
 
 use odocal_log::{read_log, Mode, ReadOptions};
-use odocal_pipeline::{calibrate_log, NoProgress, Options};
+use odocal_pipeline::{calibrate_log, NoProgress, Options, PipelineError};
 use proptest::prelude::*;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 static COUNTER: AtomicUsize = AtomicUsize::new(0);
+
+/// Cases per property: `ODOCAL_FUZZ_CASES`, else 300.
+fn cases() -> u32 {
+    std::env::var("ODOCAL_FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(300)
+}
 
 fn scratch_file(bytes: &[u8]) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("odocal-fuzz-{}", std::process::id()));
@@ -74,7 +88,7 @@ fn valid_lines() -> Vec<String> {
         lines.push(format!("ENCODER {} {} {t:.6} host {t:.6}", 3 * k, 5 * k));
         if k % 5 == 0 {
             let ranges: Vec<String> = (0..11)
-                .map(|i| format!("{:.3}", 1.0 + 0.1 * i as f64))
+                .map(|i| format!("{:.3}", 1.0 + 0.1 * i as f64 + 0.002 * k as f64))
                 .collect();
             lines.push(format!(
                 "RAWLASER1 2 -1.5 3.0 0.3 4.0 0.01 0 11 {} 0 {t:.6} host {t:.6}",
@@ -125,6 +139,10 @@ enum Edit {
     FrozenScan(usize),
     WrapCounters(u32),
     InsertBytes(usize, Vec<u8>),
+    // The hostile data of issue 22.
+    ScaleTimestamps(f64),
+    ScaleCounts(i64),
+    OffsetCounts(i64),
 }
 
 fn edit() -> impl Strategy<Value = Edit> {
@@ -159,7 +177,50 @@ fn edit() -> impl Strategy<Value = Edit> {
             )
         )
             .prop_map(|(l, b)| Edit::InsertBytes(l, b)),
+        time_scale().prop_map(Edit::ScaleTimestamps),
+        prop_oneof![Just(1_000i64), Just(1_000_000), Just(1_000_000_000_000)]
+            .prop_map(Edit::ScaleCounts),
+        prop_oneof![
+            Just(1i64 << 53),
+            Just(1i64 << 56),
+            Just(1i64 << 62),
+            Just(-(1i64 << 62))
+        ]
+        .prop_map(Edit::OffsetCounts),
     ]
+}
+
+/// Factors that turn seconds into another unit (or into nonsense).
+fn time_scale() -> impl Strategy<Value = f64> {
+    prop_oneof![Just(1e3), Just(1e6), Just(1e9), Just(1e290), 1e3f64..1e12]
+}
+
+/// Applies `f` to both timestamps of every message line.
+fn map_timestamps(lines: &mut [String], f: impl Fn(f64) -> f64) {
+    for line in lines.iter_mut() {
+        with_tokens(line, |toks| {
+            if let Some(i) = timestamp_index(toks) {
+                for k in [i, i + 2] {
+                    if let Some(t) = toks.get(k).and_then(|t| t.parse::<f64>().ok()) {
+                        toks[k] = format!("{:e}", f(t));
+                    }
+                }
+            }
+        });
+    }
+}
+
+/// Applies `f` to both counts of every ENCODER line.
+fn map_counts(lines: &mut [String], f: impl Fn(i64) -> i64) {
+    for line in lines.iter_mut().filter(|x| x.starts_with("ENCODER")) {
+        with_tokens(line, |toks| {
+            for k in [1, 2] {
+                if let Some(v) = toks.get(k).and_then(|t| t.parse::<i64>().ok()) {
+                    toks[k] = f(v).to_string();
+                }
+            }
+        });
+    }
 }
 
 /// The timestamp token (third from the end) of a message line, when it has one.
@@ -288,11 +349,30 @@ fn apply(lines: &mut Vec<String>, e: &Edit) {
             }
             line.insert_str(cut, &String::from_utf8_lossy(bytes));
         }
+        Edit::ScaleTimestamps(f) => map_timestamps(lines, |t| t * f),
+        Edit::ScaleCounts(f) => map_counts(lines, |v| v.saturating_mul(*f)),
+        Edit::OffsetCounts(d) => map_counts(lines, |v| v.saturating_add(*d)),
     }
 }
 
+/// Reads the valid log after `edit_lines` (written as `name` in the scratch folder)
+/// and calibrates it.
+fn calibrate_lines(
+    name: &str,
+    edit_lines: impl FnOnce(&mut Vec<String>),
+) -> Result<(), PipelineError> {
+    let mut lines = valid_lines();
+    lines.retain(|l| !l.starts_with("FLASER"));
+    edit_lines(&mut lines);
+    let path = scratch_file(lines.join("\n").as_bytes()).with_file_name(name);
+    std::fs::write(&path, lines.join("\n")).expect("write the log");
+    let log = read_log(&path, &ReadOptions::default()).expect("the edited log reads");
+    let _ = std::fs::remove_file(&path);
+    calibrate_log(&log, &Options::default(), &NoProgress).map(|_| ())
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 300, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: cases(), ..ProptestConfig::default() })]
 
     #[test]
     fn garbage_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..3000)) {
@@ -327,6 +407,38 @@ proptest! {
             bytes.splice(p..p, ins.bytes());
         }
         exercise(&bytes);
+    }
+
+    #[test]
+    fn timestamps_in_another_unit_are_refused_by_name(scale in time_scale()) {
+        let err = calibrate_lines("units.log", |l| map_timestamps(l, |t| t * scale)).unwrap_err();
+        prop_assert!(matches!(err, PipelineError::Implausible(_)), "{}", err);
+        prop_assert!(err.to_string().contains("write the timestamps in seconds"), "{}", err);
+    }
+
+    #[test]
+    fn counts_no_wheel_can_make_are_refused_by_name(factor in 1_000_000i64..1_000_000_000_000) {
+        let err = calibrate_lines("scaled.log", |l| map_counts(l, |v| v * factor)).unwrap_err();
+        prop_assert!(matches!(err, PipelineError::Implausible(_)), "{}", err);
+        prop_assert!(err.to_string().contains("revolutions per second"), "{}", err);
+    }
+
+    #[test]
+    fn json_timestamps_in_another_unit_are_refused(step in prop_oneof![Just(1_000u64), Just(1_000_000), Just(1_000_000_000)]) {
+        let mut text = String::new();
+        for k in 0..20u64 {
+            text += &format!(
+                "{{\"timestamp\": [{s}, 0], \"readings\": [1.0, 1.1, {r}], \"theta\": [-0.1, 0.0, 0.1], \
+                 \"left\": {}, \"right\": {}, \"leftTimestamp\": [{s}, 0], \"rightTimestamp\": [{s}, 0]}}\n",
+                3 * k, 4 * k, s = 100 + k * step, r = 1.2 + 0.01 * k as f64
+            );
+        }
+        let path = scratch_file(text.as_bytes());
+        let log = read_log(&path, &ReadOptions::default()).expect("the JSON log reads");
+        let _ = std::fs::remove_file(&path);
+        let opts = Options { ticks_per_revolution: Some(1000.0), ..Options::default() };
+        let err = calibrate_log(&log, &opts, &NoProgress).map(|_| ()).unwrap_err();
+        prop_assert!(matches!(err, PipelineError::Implausible(_)), "{}", err);
     }
 }
 

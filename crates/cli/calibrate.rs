@@ -71,8 +71,9 @@ pub struct Args {
     /// ±0.5 s of --time-offset, or ±--time-offset-range), before observability is judged.
     #[arg(long)]
     pub estimate_time_offset: bool,
-    /// Half-width (s) of the clock-offset search; implies --estimate-time-offset.
-    #[arg(long, value_name = "S")]
+    /// Half-width (s) of the clock-offset search, at most half the log's span;
+    /// implies --estimate-time-offset.
+    #[arg(long, value_name = "S", value_parser = positive_seconds)]
     pub time_offset_range: Option<f64>,
     /// Identity first guesses for every scan pair (default: odometry with a rough
     /// estimate from 300 evenly spread pairs, when the log has at least 600).
@@ -95,6 +96,16 @@ pub struct Args {
     /// Print one JSON object instead of the human summary.
     #[arg(long)]
     pub json: bool,
+}
+
+/// A positive, finite number of seconds (for `--time-offset-range`).
+fn positive_seconds(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "expected a positive number of seconds, got '{text}'"
+        )),
+    }
 }
 
 /// Runs `odocal calibrate`.

@@ -57,6 +57,11 @@ pub enum PipelineError {
     /// A setting is out of range.
     #[error("invalid setting: {0}")]
     InvalidSetting(String),
+    /// The log's numbers cannot be those of a real robot (timestamps in the wrong
+    /// unit, encoder counts at an impossible rate): calibrating would give wrong
+    /// numbers.
+    #[error("implausible log: {0}")]
+    Implausible(String),
 }
 
 impl PipelineError {

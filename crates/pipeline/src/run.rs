@@ -115,6 +115,7 @@ pub fn synchronize_and_match(
     timing: &mut Timing,
 ) -> Result<Synchronized, PipelineError> {
     let ticks = ticks_per_revolution(log, opts)?;
+    health::plausibility::check(log, ticks)?;
     let t_sync = Instant::now();
     // Each scan stands for its reference time (the timestamp without a sweep).
     let scan_times: Vec<f64> = (0..log.scans.len())
@@ -386,6 +387,10 @@ pub fn calibrate_log(
     let mut timing = Timing::default();
     let (log, mut findings, read_time_sigma) = health::check_log_and_read_times(log, opts);
     let log: &Log = &log;
+    // A range asked for is checked before the long stages, so a refusal is quick.
+    if let Some(range) = opts.estimate_time_offset {
+        crate::time_offset::checked_range(range, scan_span(log), true)?;
+    }
     let mut synced = synchronize_and_match(log, opts, progress, &mut timing)
         .map_err(|e| PipelineError::with_faults(e, &findings))?;
     synced.read_time_sigma = read_time_sigma;
@@ -411,11 +416,11 @@ pub fn calibrate_log(
 
     let mut offset = None;
     if let Some(range) = search_range {
-        if !(range.is_finite() && range > 0.0) {
-            return Err(PipelineError::InvalidSetting(format!(
-                "the clock-offset search range must be positive, got {range} s"
-            )));
-        }
+        let range = crate::time_offset::checked_range(
+            range,
+            scan_span(log),
+            opts.estimate_time_offset.is_some(),
+        )?;
         // Estimate first, on an estimate not yet judged: the verdicts come after.
         let t = Instant::now();
         let base =
@@ -468,6 +473,14 @@ pub fn calibrate_log(
     })
 }
 
+/// Time from the first scan to the last (s).
+fn scan_span(log: &Log) -> f64 {
+    match (log.scans.scans.first(), log.scans.scans.last()) {
+        (Some(a), Some(b)) => b.t - a.t,
+        _ => 0.0,
+    }
+}
+
 /// A warning when the estimated offset lies at the edge of the search range: the true
 /// offset may lie beyond it.
 fn edge_warning(
@@ -477,7 +490,7 @@ fn edge_warning(
     range: f64,
     estimate: f64,
 ) -> Option<Finding> {
-    let step = range / ((range / crate::time_offset::GRID_STEP_S).round().max(5.0));
+    let step = crate::time_offset::grid_step(range);
     if (estimate - start).abs() < range - 1.5 * step {
         return None;
     }

@@ -194,11 +194,20 @@ impl SyncLimits {
 /// more are pieces as they are.
 pub const MAX_PIECE_S: f64 = 0.025;
 
+/// Most pieces one span between two encoder records is cut into, whatever its length
+/// in seconds: the profile's memory stays proportional to the number of records
+/// (timestamps in the wrong unit, say nanoseconds, make spans of 10⁸ "seconds" that
+/// would otherwise be cut into billions of pieces).
+pub const MAX_PIECES_PER_SPAN: usize = 64;
+
 /// The encoder stream, ready for interpolation.
 #[derive(Debug, Clone, Copy)]
 pub struct EncoderTrack<'a> {
     records: &'a [EncoderRecord],
     rad_per_tick: f64,
+    /// The first record's counts: every count is taken relative to them, in integer
+    /// arithmetic, before it becomes an `f64` (counts above 2^53 would lose ticks).
+    base: (i64, i64),
 }
 
 impl<'a> EncoderTrack<'a> {
@@ -207,7 +216,23 @@ impl<'a> EncoderTrack<'a> {
         EncoderTrack {
             records,
             rad_per_tick: std::f64::consts::TAU / ticks_per_revolution,
+            base: records.first().map_or((0, 0), |r| (r.left, r.right)),
         }
+    }
+
+    /// A count relative to the first record's, exact while the difference is below
+    /// 2^53 ticks (however large the counts themselves are).
+    fn relative(count: i64, base: i64) -> f64 {
+        (i128::from(count) - i128::from(base)) as f64
+    }
+
+    /// Record `i`'s counts (left, right) relative to the first record's.
+    fn counts(&self, i: usize) -> (f64, f64) {
+        let r = &self.records[i];
+        (
+            Self::relative(r.left, self.base.0),
+            Self::relative(r.right, self.base.1),
+        )
     }
 
     /// Radians of wheel rotation per tick.
@@ -245,8 +270,9 @@ impl<'a> EncoderTrack<'a> {
         let a = &self.records[i - 1];
         let b = &self.records[i];
         let span = b.t - a.t;
+        let (pa, pb) = (self.counts(i - 1), self.counts(i));
         if span.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-            return (b.left as f64, b.right as f64);
+            return pb;
         }
         let u = ((t - a.t) / span).clamp(0.0, 1.0);
         let (sa, sb) = (self.slope(i - 1), self.slope(i));
@@ -254,13 +280,10 @@ impl<'a> EncoderTrack<'a> {
         let h10 = u * (1.0 - u) * (1.0 - u);
         let h01 = u * u * (3.0 - 2.0 * u);
         let h11 = u * u * (u - 1.0);
-        let curve = |pa: i64, pb: i64, ma: f64, mb: f64| {
-            h00 * pa as f64 + h10 * span * ma + h01 * pb as f64 + h11 * span * mb
+        let curve = |pa: f64, pb: f64, ma: f64, mb: f64| {
+            h00 * pa + h10 * span * ma + h01 * pb + h11 * span * mb
         };
-        (
-            curve(a.left, b.left, sa.0, sb.0),
-            curve(a.right, b.right, sa.1, sb.1),
-        )
+        (curve(pa.0, pb.0, sa.0, sb.0), curve(pa.1, pb.1, sa.1, sb.1))
     }
 
     /// The count rates (ticks/s, left and right) at record `k`: the three-point
@@ -273,8 +296,8 @@ impl<'a> EncoderTrack<'a> {
             (h > 0.0).then(|| {
                 (
                     h,
-                    (q.left - p.left) as f64 / h,
-                    (q.right - p.right) as f64 / h,
+                    Self::relative(q.left, p.left) / h,
+                    Self::relative(q.right, p.right) / h,
                 )
             })
         };
@@ -299,7 +322,9 @@ impl<'a> EncoderTrack<'a> {
         from: (f64, f64, f64),
         to: (f64, f64, f64),
     ) {
-        let n = ((to.0 - from.0) / MAX_PIECE_S - 1e-9).ceil().max(1.0) as usize;
+        let n = ((to.0 - from.0) / MAX_PIECE_S - 1e-9)
+            .ceil()
+            .clamp(1.0, MAX_PIECES_PER_SPAN as f64) as usize;
         let mut prev = from;
         for k in 1..=n {
             let next = if k == n {
@@ -314,7 +339,8 @@ impl<'a> EncoderTrack<'a> {
         }
     }
 
-    /// Cumulative ticks (left, right) at `t`, or why they are not known well enough.
+    /// Cumulative ticks (left, right) at `t` relative to the first record's counts,
+    /// or why they are not known well enough.
     pub fn ticks_at(&self, t: f64, max_gap: f64) -> Result<(f64, f64), DiscardReason> {
         let i = self.bracket(t, max_gap)?;
         Ok(self.ticks_between(i, t))
@@ -353,7 +379,7 @@ impl<'a> EncoderTrack<'a> {
             // A record at the same instant as the last (colliding timestamps) adds
             // its counts to the next piece, so that the pieces still sum up.
             if rec.t > tp {
-                let (l, r) = (rec.left as f64, rec.right as f64);
+                let (l, r) = self.counts(i0 + k);
                 self.push_pieces(&mut profile, i0 + k, (tp, lp, rp), (rec.t, l, r));
                 (tp, lp, rp) = (rec.t, l, r);
             }
@@ -515,6 +541,59 @@ mod tests {
         assert_eq!(m.profile.len(), 32);
         assert!((m.dphi_l - 80.0 * std::f64::consts::TAU / 100.0).abs() < 1e-12);
         assert!(track.motion(0.2, 1.0001, &lim).is_err());
+    }
+
+    #[test]
+    fn pieces_per_span_are_capped_whatever_the_time_unit() {
+        // Timestamps in milliseconds read as seconds (records 2000 "s" apart, an
+        // interval of 40000 "s"): uncapped, each span would be cut into 80000 pieces
+        // (with nanoseconds, 8e10 of them: gigabytes, then an abort).
+        let recs: Vec<EncoderRecord> = (0..40)
+            .map(|k| rec(k as f64 * 2e3, 10 * k, 10 * k))
+            .collect();
+        let track = EncoderTrack::new(&recs, 100.0);
+        let lim = SyncLimits {
+            max_encoder_gap: 1e4,
+            still_ticks: 1.0,
+            max_interval: 1e5,
+        };
+        let m = track.motion(1e3, 4.1e4, &lim).unwrap();
+        assert!(
+            m.profile.len() <= 21 * MAX_PIECES_PER_SPAN,
+            "{}",
+            m.profile.len()
+        );
+        let sum: f64 = m.profile.iter().map(|p| p.dt).sum();
+        assert!((sum - m.dt).abs() < 1e-6 * m.dt);
+    }
+
+    #[test]
+    fn counts_above_2_pow_53_keep_every_tick() {
+        // The same motion with counts starting at 0 and at 2^56 (where an f64 steps by
+        // 16 ticks): the wheel rotations and every piece agree.
+        let make = |base: i64| -> Vec<EncoderRecord> {
+            (0..60)
+                .map(|k| rec(k as f64 * 0.01, base + 7 * k + k * k / 3, base - 5 * k))
+                .collect()
+        };
+        let (small, huge) = (make(0), make(1 << 56));
+        let a = EncoderTrack::new(&small, 1000.0)
+            .motion(0.105, 0.5, &limits())
+            .unwrap();
+        let b = EncoderTrack::new(&huge, 1000.0)
+            .motion(0.105, 0.5, &limits())
+            .unwrap();
+        assert_eq!(a.profile.len(), b.profile.len());
+        assert!(
+            (a.dphi_l - b.dphi_l).abs() < 1e-12,
+            "{} {}",
+            a.dphi_l,
+            b.dphi_l
+        );
+        assert!((a.dphi_r - b.dphi_r).abs() < 1e-12);
+        for (p, q) in a.profile.iter().zip(&b.profile) {
+            assert!((p.dphi_l - q.dphi_l).abs() < 1e-12 && (p.dphi_r - q.dphi_r).abs() < 1e-12);
+        }
     }
 
     #[test]

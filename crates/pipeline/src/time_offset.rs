@@ -24,6 +24,13 @@ pub const GRID_STEP_S: f64 = 0.01;
 pub const GRID_SAMPLES: usize = 1500;
 /// Tolerance of the golden-section refinement (s).
 pub const TOLERANCE_S: f64 = 1e-4;
+/// At most this many grid steps on each side of the start: a wide range is searched
+/// with coarser steps, so the search costs at most `2 · MAX_GRID_STEPS + 1` solves on
+/// [`GRID_SAMPLES`] samples whatever the range.
+pub const MAX_GRID_STEPS: usize = 500;
+/// The range may reach at most this fraction of the scans' time span: beyond it, fewer
+/// than half of the scan pairs still have encoder records at the shifted times.
+pub const MAX_RANGE_OF_SPAN: f64 = 0.5;
 /// Squared normalized residuals are capped at this value.
 const CAP: f64 = 25.0;
 
@@ -38,6 +45,44 @@ pub struct OffsetEstimate {
     pub cost_at_start: f64,
     /// The coarse grid: (offset s, cost on its subsample of the samples).
     pub grid: Vec<(f64, f64)>,
+}
+
+/// The grid step (s) of a search over `start ± range`: [`GRID_STEP_S`], coarser when
+/// the range would need more than [`MAX_GRID_STEPS`] steps on each side (at least 5).
+pub fn grid_step(range: f64) -> f64 {
+    range / grid_steps(range) as f64
+}
+
+/// The number of grid steps on each side of the start.
+fn grid_steps(range: f64) -> usize {
+    (range / GRID_STEP_S)
+        .round()
+        .clamp(5.0, MAX_GRID_STEPS as f64) as usize
+}
+
+/// The search range to use: `range` checked against the scans' time span. A range
+/// asked for on the command line (`asked`) is refused, naming the value and the
+/// largest the log supports, when it is not a positive number or exceeds
+/// [`MAX_RANGE_OF_SPAN`] of the span; a range the pipeline chose is clamped to it.
+pub fn checked_range(range: f64, scan_span: f64, asked: bool) -> Result<f64, PipelineError> {
+    if !(range.is_finite() && range > 0.0) {
+        return Err(PipelineError::InvalidSetting(format!(
+            "the clock-offset search range must be a positive number of seconds, got {range}"
+        )));
+    }
+    let largest = MAX_RANGE_OF_SPAN * scan_span.max(0.0);
+    if range <= largest {
+        return Ok(range);
+    }
+    if asked {
+        return Err(PipelineError::InvalidSetting(format!(
+            "--time-offset-range {range} s is more than the log can support: the scans span \
+             {scan_span:.1} s, and an offset beyond ±{largest:.1} s leaves fewer than half of \
+             the scan pairs with encoder records; use at most --time-offset-range {:.1}",
+            (largest * 10.0).floor() / 10.0
+        )));
+    }
+    Ok(largest)
 }
 
 /// Robust scale (1.4826 · median absolute value) of each residual component.
@@ -130,8 +175,8 @@ pub fn estimate_time_offset(
     // The coarse grid only has to find the basin: a subsample keeps it fast on long
     // logs; the refinement uses every sample.
     let coarse_every = synced.samples.len().div_ceil(GRID_SAMPLES).max(1);
-    let n = ((range / GRID_STEP_S).round() as i64).max(5);
-    let step = range / n as f64;
+    let n = grid_steps(range) as i64;
+    let step = grid_step(range);
     let grid: Vec<(f64, f64)> = (-n..=n)
         .into_par_iter()
         .map(|i| {
@@ -196,6 +241,23 @@ pub fn estimate_time_offset(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ranges_beyond_the_log_are_refused_and_the_grid_is_bounded() {
+        assert_eq!(checked_range(1.0, 60.0, true).unwrap(), 1.0);
+        let e = checked_range(1e9, 60.0, true).unwrap_err().to_string();
+        assert!(
+            e.contains("1000000000") && e.contains("at most --time-offset-range 30"),
+            "{e}"
+        );
+        assert!(checked_range(f64::NAN, 60.0, true).is_err());
+        assert!(checked_range(-1.0, 60.0, false).is_err());
+        assert_eq!(checked_range(45.0, 60.0, false).unwrap(), 30.0);
+        assert_eq!(grid_steps(0.5), 50);
+        assert!((grid_step(0.5) - GRID_STEP_S).abs() < 1e-12);
+        assert_eq!(grid_steps(1e9), MAX_GRID_STEPS);
+        assert_eq!(grid_steps(1e300), MAX_GRID_STEPS);
+    }
 
     #[test]
     fn scale_is_robust() {

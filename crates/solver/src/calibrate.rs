@@ -30,6 +30,31 @@ pub const MIN_SAMPLES: usize = 10;
 /// decides).
 pub const STEP1_SINGULAR_CONDITION: f64 = 1e12;
 
+/// The first-round noise estimate is taken as the original package takes it unless
+/// it exceeds, in some component, this many times the same samples' residual σ at the
+/// estimate re-solved without the first round's outliers.
+pub const PULLED_ESTIMATE_RATIO: f64 = 1.5;
+
+/// The scan-matching σ of [`SigmaEstimate::FirstRound`]: the residuals of the first
+/// (untrimmed) estimate over the samples the first round kept — unless one gross
+/// outlier pulled that estimate so far that every kept residual grew (a 10 m failure
+/// among 300 samples made σ 35× the noise, and every parameter's σ with it): then the
+/// residuals of the same samples at the estimate re-solved without the outliers
+/// (`resolved`). On clean data the two agree and the package's estimate stands.
+fn first_round_sigmas(first: &[[f64; 3]], resolved: Option<&[[f64; 3]]>) -> [f64; 3] {
+    let s_first = residual_sigmas(first);
+    let Some(resolved) = resolved else {
+        return s_first;
+    };
+    let s_resolved = residual_sigmas(resolved);
+    let pulled = (0..3).any(|c| s_first[c] > PULLED_ESTIMATE_RATIO * s_resolved[c]);
+    if pulled {
+        s_resolved
+    } else {
+        s_first
+    }
+}
+
 /// Settings of [`calibrate`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct SolveOptions {
@@ -330,6 +355,9 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // first (untrimmed) closed-form estimate over the samples kept after the first
     // trimming round (all samples when there is no trimming).
     let mut noise_residuals: Option<Vec<[f64; 3]>> = None;
+    // The same samples' residuals at the estimate re-solved without the first round's
+    // outliers: when an outlier pulled the first estimate, these are the noise.
+    let mut resolved_residuals: Option<Vec<[f64; 3]>> = None;
     // Rules that judge every sample at the current estimate (samples may come back)
     // stop when the kept set no longer changes; the others drop from the active set.
     let whole = options.trim.judges_all_samples();
@@ -378,11 +406,15 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
             });
         }
         cf = closed_form_packed(&active, tw, &held, &mut scratch)?;
+        if round == 0 {
+            resolved_residuals = Some(residuals_at(&active, &cf.params));
+        }
     }
     let sm_sigma = match options.sigma_from {
-        SigmaEstimate::FirstRound => {
-            residual_sigmas(noise_residuals.as_deref().unwrap_or(&scratch.residuals))
-        }
+        SigmaEstimate::FirstRound => first_round_sigmas(
+            noise_residuals.as_deref().unwrap_or(&scratch.residuals),
+            resolved_residuals.as_deref(),
+        ),
         SigmaEstimate::FinalSet => residual_sigmas(&scratch.residuals),
     };
 

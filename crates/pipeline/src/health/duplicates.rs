@@ -38,6 +38,19 @@ fn resolution(times: impl Iterator<Item = f64>) -> f64 {
     best
 }
 
+/// The mean of one wheel's counts over a group, rounded; taken relative to the first
+/// count in integer arithmetic, so that counts above 2^53 keep every tick (a mean of
+/// the counts as `f64` rounded them to multiples of 16 at 2^56).
+fn mean_count(group: &[EncoderRecord], count: impl Fn(&EncoderRecord) -> i64) -> i64 {
+    let base = group.first().map_or(0, &count);
+    let sum: i128 = group
+        .iter()
+        .map(|r| i128::from(count(r)) - i128::from(base))
+        .sum();
+    let mean = (sum as f64 / group.len().max(1) as f64).round() as i128;
+    i64::try_from(i128::from(base) + mean).unwrap_or(base)
+}
+
 /// Drops exact repeats of encoder records and merges records sharing a timestamp into
 /// one (their mean count). `records` is sorted by time.
 pub fn encoders(records: &mut Vec<EncoderRecord>) -> Vec<Finding> {
@@ -48,12 +61,9 @@ pub fn encoders(records: &mut Vec<EncoderRecord>) -> Vec<Finding> {
     let mut group: Vec<EncoderRecord> = Vec::new();
     let flush = |group: &mut Vec<EncoderRecord>, out: &mut Vec<EncoderRecord>| {
         if let Some(first) = group.first().copied() {
-            let n = group.len() as f64;
-            let l = group.iter().map(|r| r.left as f64).sum::<f64>() / n;
-            let r = group.iter().map(|r| r.right as f64).sum::<f64>() / n;
             out.push(EncoderRecord {
-                left: l.round() as i64,
-                right: r.round() as i64,
+                left: mean_count(group, |r| r.left),
+                right: mean_count(group, |r| r.right),
                 ..first
             });
         }
@@ -172,4 +182,40 @@ pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore) -> Vec<Finding> {
     }
     *scans = out;
     findings
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_above_2_pow_53_keep_every_tick() {
+        let base = 1i64 << 56;
+        let mut recs: Vec<EncoderRecord> = (0..10)
+            .map(|k| EncoderRecord {
+                t: k as f64 * 0.01,
+                left: base + 3 * k,
+                right: base - 5 * k,
+                line: k as u64 + 1,
+            })
+            .collect();
+        // Two records at one instant: merged into their mean.
+        recs.insert(
+            5,
+            EncoderRecord {
+                left: base + 3 * 4 + 2,
+                right: base - 5 * 4,
+                line: 100,
+                ..recs[4]
+            },
+        );
+        let _ = encoders(&mut recs);
+        assert_eq!(recs.len(), 10);
+        for (k, r) in recs.iter().enumerate() {
+            let k = k as i64;
+            let merged = if k == 4 { 1 } else { 0 };
+            assert_eq!(r.left - base, 3 * k + merged, "record {k}");
+            assert_eq!(r.right - base, -5 * k, "record {k}");
+        }
+    }
 }

@@ -7,7 +7,8 @@
 //! frozen scans ([`frozen`]), wheel angles wrapped to one turn ([`angle_wraps`]),
 //! encoder counter wraps without a modulus ([`wraps`]),
 //! physically impossible encoder jumps ([`spikes`]), gaps ([`gaps`]), counts read at
-//! times that vary around their timestamps ([`read_jitter`]). After matching
+//! times that vary around their timestamps ([`read_jitter`]); timestamps or counts
+//! that cannot be a real robot's are refused ([`plausibility`]). After matching
 //! ([`after_matching`], on the samples): a large laser–encoder clock offset
 //! ([`clock_offset`]) and wheel-slip episodes ([`slip`]).
 
@@ -17,6 +18,7 @@ pub mod clock_offset;
 pub mod duplicates;
 pub mod frozen;
 pub mod gaps;
+pub mod plausibility;
 pub mod read_jitter;
 pub mod slip;
 pub mod spikes;
