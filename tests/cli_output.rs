@@ -37,14 +37,32 @@ fn assert_refused(o: &Output, needle: &str) {
     assert!(err.contains("error:") && err.contains(needle), "{err}");
 }
 
+/// Devices and FIFOs are refused. The devices are reached through symlinks in a
+/// temporary directory: a writer that wrongly renames over its target then replaces
+/// the link, not the machine's /dev/full (as the writer before this test did when run
+/// as root).
 #[test]
-fn devices_are_not_replaced() {
+fn devices_and_fifos_are_not_replaced() {
+    let dir = temp_dir("out-devices");
+    let fifo = dir.join("report.fifo");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .expect("mkfifo");
+    assert!(made.success());
+    let mut targets = vec![(fifo.clone(), "FIFO")];
     for dev in ["/dev/full", "/dev/null"] {
-        let o = odocal(&["calibrate", s(&demo()), "--report", dev]);
-        assert_refused(&o, "a device");
-        let t = fs::metadata(dev).unwrap().file_type();
-        assert!(t.is_char_device(), "{dev} is still a device");
+        let link = dir.join(format!("{}.html", &dev[5..]));
+        std::os::unix::fs::symlink(dev, &link).unwrap();
+        targets.push((link, "a device"));
     }
+    for (target, kind) in &targets {
+        let o = odocal(&["calibrate", s(&demo()), "--report", s(target)]);
+        assert_refused(&o, kind);
+        let t = fs::metadata(target).unwrap().file_type();
+        assert!(t.is_char_device() || t.is_fifo(), "{target:?} was replaced");
+    }
+    let _ = fs::remove_dir_all(&dir);
 }
 
 #[test]

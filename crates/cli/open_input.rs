@@ -11,8 +11,9 @@ use std::fs::File;
 use std::io::{self, BufReader, Cursor, Read};
 use std::path::Path;
 
-/// Bytes read ahead to tell a bag from a text log (and binary data from text).
-const HEAD_BYTES: u64 = 1 << 16;
+/// Bytes read ahead to tell a bag from a text log, and all the log reader checks for
+/// NUL bytes before parsing (its buffer: 256 kB).
+const HEAD_BYTES: u64 = 1 << 18;
 
 /// True when `path` is standard input.
 pub fn is_stdin(path: &Path) -> bool {
