@@ -1,12 +1,16 @@
-//! `odocal calibrate LOG`: raw log in, calibrated robot out.
+//! `odocal calibrate LOG [LOG …]`: raw logs in, calibrated robot out (several logs of
+//! one robot are calibrated jointly).
 
 use crate::input::InputArgs;
 use crate::nominal::{describe, odometry_only_mode};
 use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
-use odocal_pipeline::{calibrate_log, Options, Trim};
-use odocal_report::{build_report, sha256_of_input, write_html, write_outputs, Provenance};
+use odocal_log::Log;
+use odocal_pipeline::{calibrate_log, calibrate_logs, Options, Trim};
+use odocal_report::{
+    build_joint_report, build_report, sha256_of_input, write_html, write_outputs, Provenance,
+};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -101,11 +105,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let input = &args.input;
     let pool = input.thread_pool()?;
     let t_parse = Instant::now();
-    let mut log = input.read_log()?;
+    let paths = input.paths();
+    let mut logs = input.read_logs()?;
     let parse_s = t_parse.elapsed().as_secs_f64();
 
     let initial_params = input.nominal()?;
-    let odometry_only = odometry_only_mode(&input.read.log, &mut log, initial_params.as_ref())?;
+    let mut odometry_only = None;
+    for (path, log) in paths.iter().zip(logs.iter_mut()) {
+        let mode = odometry_only_mode(path, log, initial_params.as_ref())?;
+        odometry_only = odometry_only.or(mode);
+    }
     let mut opts = Options {
         initial_params,
         ticks_per_revolution: input.read.ticks_per_rev,
@@ -126,11 +135,33 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     opts.solve.constraints = args.partial.constraints()?;
 
     let bar = Bar::for_stderr();
-    let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
+    let (mut outcome, mut report) = if let [log] = &logs[..] {
+        let outcome = pool.install(|| calibrate_log(log, &opts, &bar))?;
+        let report = build_report(paths[0], log, &opts, &outcome);
+        (outcome, report)
+    } else {
+        let named: Vec<(String, &Log)> = paths
+            .iter()
+            .map(|p| p.display().to_string())
+            .zip(&logs)
+            .collect();
+        let named: Vec<(&str, &Log)> = named.iter().map(|(p, l)| (p.as_str(), *l)).collect();
+        let joint = pool.install(|| calibrate_logs(&named, &opts, &bar))?;
+        let all: Vec<&Log> = logs.iter().collect();
+        let mut report = build_joint_report(&paths, &all, &opts, &joint);
+        for (row, path) in report.logs.iter_mut().zip(&paths) {
+            row.sha256 = Some(
+                sha256_of_input(path)
+                    .with_context(|| format!("cannot read {} for its checksum", path.display()))?
+                    .0,
+            );
+        }
+        (joint.joint, report)
+    };
     outcome.timing.parse = parse_s;
-    let mut report = build_report(&input.read.log, &log, &opts, &outcome);
-    let (input_sha256, input_bytes) = sha256_of_input(&input.read.log)
-        .with_context(|| format!("cannot read {} for its checksum", input.read.log.display()))?;
+    report.timing_s.parse = parse_s;
+    let (input_sha256, input_bytes) = sha256_of_input(paths[0])
+        .with_context(|| format!("cannot read {} for its checksum", paths[0].display()))?;
     report.provenance = Some(Provenance {
         command_line: std::env::args().collect::<Vec<_>>().join(" "),
         version: env!("CARGO_PKG_VERSION").to_string(),
