@@ -45,8 +45,8 @@ fn three_logs_shrink_sigma_and_stay_near_the_truth() {
     assert!(e.sigma[2] <= 0.7 * best_b, "{} vs {best_b}", e.sigma[2]);
     let samples: usize = single.iter().map(|s| s.samples_synchronized).sum();
     assert_eq!(e.samples_synchronized, samples);
-    for i in 0..6 {
-        let z = (e.params[i] - truth[i]) / e.sigma[i];
+    for (i, t) in truth.iter().enumerate() {
+        let z = (e.params[i] - t) / e.sigma[i];
         assert!(z.abs() < 4.0, "parameter {i}: {z:.1}σ from the truth");
     }
     for (k, c) in joint.contributions.iter().enumerate() {
