@@ -68,3 +68,22 @@ fn a_log_that_fails_is_named() {
     assert!(err.contains("empty.log"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn logs_of_two_robots_are_refused_with_their_names() {
+    // A Khepera III and a TurtleBot-class robot: one model fits neither.
+    let o = odocal(&[
+        "calibrate",
+        "fixtures/demo.log",
+        "fixtures/bags/turtlebot_lds.bag",
+    ]);
+    let err = stderr(&o);
+    assert!(!o.status.success(), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.contains("do not describe one robot"), "{err}");
+    assert!(
+        err.contains("turtlebot_lds.bag and the joint estimate disagree"),
+        "{err}"
+    );
+    assert!(err.contains("calibrate them separately"), "{err}");
+}

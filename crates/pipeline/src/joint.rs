@@ -69,6 +69,18 @@ pub enum JointError {
     /// The joint solve failed or was refused.
     #[error("the joint calibration of the logs: {0}")]
     Joint(PipelineError),
+    /// The joint estimate was refused, and logs disagree with it: they do not
+    /// describe one robot with one mounting.
+    #[error(
+        "the logs do not describe one robot: {sentences}; calibrate them separately, or \
+         without the log(s) named (the joint estimate was refused: {refusal})"
+    )]
+    Disagree {
+        /// Each disagreeing log's sentence, joined.
+        sentences: String,
+        /// The joint refusal.
+        refusal: PipelineError,
+    },
 }
 
 /// Calibrates one robot from several logs: `logs` pairs each log with the name the
@@ -115,9 +127,35 @@ pub fn calibrate_logs(
     }
     let solve_options = opts.solve_options();
     let calibration = odocal_solver::calibrate(&samples, &solve_options)
-        .map_err(PipelineError::from)
-        .and_then(|c| refuse_poorly_determined(c, &solve_options))
-        .map_err(|e| JointError::Joint(e.with_faults(&health)))?;
+        .map_err(|e| JointError::Joint(PipelineError::from(e).with_faults(&health)))?;
+    let agreements: Vec<Consistency> = logs
+        .iter()
+        .zip(&outcomes)
+        .map(|((name, _), o)| check_log(&o.calibration, &calibration, &solve_options, name))
+        .collect();
+    let calibration = match refuse_poorly_determined(calibration, &solve_options) {
+        Ok(c) => c,
+        Err(refusal) => {
+            // Logs of different robots (or mountings) make one model fit none of them:
+            // the residuals grow and the joint verdicts weaken. Name the logs that
+            // disagree rather than ask for more driving.
+            let disagreeing: Vec<String> = agreements
+                .iter()
+                .filter_map(|a| match a {
+                    Consistency::Checked(h) if !h.agree => Some(h.sentence.clone()),
+                    _ => None,
+                })
+                .collect();
+            return Err(if disagreeing.is_empty() {
+                JointError::Joint(refusal.with_faults(&health))
+            } else {
+                JointError::Disagree {
+                    sentences: disagreeing.join("; "),
+                    refusal,
+                }
+            });
+        }
+    };
     let own: Vec<_> = outcomes.iter().map(|o| &o.calibration).collect();
     let shares = information_shares(&own);
     let mut first = 0;
@@ -125,7 +163,8 @@ pub fn calibrate_logs(
         .iter()
         .zip(&outcomes)
         .zip(shares)
-        .map(|(((name, _), o), information_share)| {
+        .zip(agreements)
+        .map(|(((_, o), information_share), agreement)| {
             let n = o.synced.samples.len();
             let used = calibration.used[first..first + n]
                 .iter()
@@ -136,7 +175,7 @@ pub fn calibrate_logs(
                 samples: n,
                 samples_used: used,
                 information_share,
-                agreement: check_log(&o.calibration, &calibration, &solve_options, name),
+                agreement,
             }
         })
         .collect();

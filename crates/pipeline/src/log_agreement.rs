@@ -4,9 +4,9 @@
 //! two-halves check's rules ([`crate::consistency`]); and the share of the
 //! information on each parameter that each log brings.
 
-use crate::consistency::{compare, Consistency};
+use crate::consistency::{compare, Consistency, HalvesCheck, Z_LIMIT};
 use nalgebra::DMatrix;
-use odocal_solver::{Calibration, SolveOptions, Verdict};
+use odocal_solver::{Calibration, SolveOptions, Verdict, PARAMETER_NAMES};
 
 /// Compares one log's own estimate `log` with the joint estimate `joint`; `name`
 /// names the log in the sentence. A log that alone does not determine every free
@@ -46,13 +46,46 @@ pub fn check_log(
         };
     }
     let what = format!("{name} and the joint estimate");
-    Consistency::Checked(Box::new(compare(
+    let mut check = compare(
         log,
         joint,
         &difference_covariance(log, joint, options),
         options,
         &what,
-    )))
+    );
+    if !check.agree {
+        check.sentence = disagreement(&what, &check);
+    }
+    Consistency::Checked(Box::new(check))
+}
+
+/// "LOG and the joint estimate disagree …": the parameters that moved and the causes
+/// that fit a whole log (not the two-halves check's causes within one log).
+fn disagreement(what: &str, h: &HalvesCheck) -> String {
+    let mut moved: Vec<usize> = (0..6).filter(|&i| h.z[i].abs() > Z_LIMIT).collect();
+    if moved.is_empty() {
+        moved = (0..6).collect();
+        moved.sort_by(|&p, &q| h.z[q].abs().total_cmp(&h.z[p].abs()));
+        moved.truncate(2);
+    }
+    let list: Vec<String> = moved
+        .iter()
+        .map(|&i| format!("{} by {:.1}σ", PARAMETER_NAMES[i], h.z[i].abs()))
+        .collect();
+    let cause = if moved.iter().all(|&i| i >= 3) {
+        "the laser was mounted elsewhere for this log"
+    } else {
+        "this log was recorded on another robot, another floor or with other tyres or \
+         load, or the laser was mounted elsewhere"
+    };
+    format!(
+        "{what} disagree beyond 3σ ({}; χ² {:.1} for {} parameters, 3σ level {:.1}): likely \
+         {cause}, or this log has a fault of its own (see its findings)",
+        list.join(", "),
+        h.chi2,
+        h.dof,
+        h.chi2_limit
+    )
 }
 
 /// `C_log − C_joint` over the free parameters when it is positive definite (the

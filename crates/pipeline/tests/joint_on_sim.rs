@@ -83,6 +83,11 @@ fn a_log_with_a_moved_laser_is_named() {
     assert!(!h.agree, "{}", h.sentence);
     assert!(h.disagreeing.contains(&"l_y".to_string()), "{h:?}");
     assert!(h.sentence.starts_with("moved.log"), "{}", h.sentence);
+    assert!(
+        h.sentence.contains("laser was mounted elsewhere"),
+        "{}",
+        h.sentence
+    );
 }
 
 /// Monte Carlo (`cargo test --release -p odocal-pipeline --test joint_on_sim --
