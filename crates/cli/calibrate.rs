@@ -1,4 +1,5 @@
-//! `odocal calibrate LOG`: raw log in, calibrated robot out.
+//! `odocal calibrate LOG [LOG …]`: raw logs in, calibrated robot out (several logs of
+//! one robot are calibrated jointly).
 
 use crate::input::InputArgs;
 use crate::nominal::{describe, odometry_only_mode};
@@ -7,8 +8,11 @@ use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
 use crate::terminal::{out, outln, write_json_stdout};
 use anyhow::Context;
-use odocal_pipeline::{calibrate_log, Options, Trim};
-use odocal_report::{build_report, sha256_of_input, write_html, write_outputs, Provenance};
+use odocal_log::Log;
+use odocal_pipeline::{calibrate_log, calibrate_logs, Options, Trim};
+use odocal_report::{
+    build_joint_report, build_report, sha256_of_input, write_html, write_outputs, Provenance,
+};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -113,20 +117,28 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
     let input = &args.input;
     let pool = input.thread_pool()?;
-    if let Some(path) = &args.report {
-        check_file_output(path, &input.read.log)
-            .with_context(|| format!("cannot write the report {}", path.display()))?;
-    }
-    if let Some(dir) = &args.out {
-        check_dir_output(dir, &input.read.log)
-            .with_context(|| format!("cannot write the results into {}", dir.display()))?;
+    for log_path in input.paths() {
+        if let Some(path) = &args.report {
+            check_file_output(path, log_path)
+                .with_context(|| format!("cannot write the report {}", path.display()))?;
+        }
+        if let Some(dir) = &args.out {
+            check_dir_output(dir, log_path)
+                .with_context(|| format!("cannot write the results into {}", dir.display()))?;
+        }
     }
     let t_parse = Instant::now();
-    let (mut log, checksum) = input.read.read_log_and_checksum()?;
+    let paths = input.paths();
+    let (mut logs, mut checksums): (Vec<Log>, Vec<Option<(String, u64)>>) =
+        input.read_logs()?.into_iter().unzip();
     let parse_s = t_parse.elapsed().as_secs_f64();
 
     let initial_params = input.nominal()?;
-    let odometry_only = odometry_only_mode(&input.read.log, &mut log, initial_params.as_ref())?;
+    let mut odometry_only = None;
+    for (path, log) in paths.iter().zip(logs.iter_mut()) {
+        let mode = odometry_only_mode(path, log, initial_params.as_ref())?;
+        odometry_only = odometry_only.or(mode);
+    }
     let mut opts = Options {
         initial_params,
         ticks_per_revolution: input.read.ticks_per_rev,
@@ -147,14 +159,37 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     opts.solve.constraints = args.partial.constraints()?;
 
     let bar = Bar::for_stderr();
-    let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
+    let (mut outcome, mut report) = if let [log] = &logs[..] {
+        let outcome = pool.install(|| calibrate_log(log, &opts, &bar))?;
+        let report = build_report(paths[0], log, &opts, &outcome);
+        (outcome, report)
+    } else {
+        let named: Vec<(String, &Log)> = paths
+            .iter()
+            .map(|p| p.display().to_string())
+            .zip(&logs)
+            .collect();
+        let named: Vec<(&str, &Log)> = named.iter().map(|(p, l)| (p.as_str(), *l)).collect();
+        let joint = pool.install(|| calibrate_logs(&named, &opts, &bar))?;
+        let all: Vec<&Log> = logs.iter().collect();
+        let mut report = build_joint_report(&paths, &all, &opts, &joint);
+        for ((row, path), checksum) in report.logs.iter_mut().zip(&paths).zip(&mut checksums) {
+            let (sha256, bytes) = match checksum.take() {
+                Some(c) => c,
+                None => sha256_of_input(path)
+                    .with_context(|| format!("cannot read {} for its checksum", path.display()))?,
+            };
+            row.sha256 = Some(sha256.clone());
+            *checksum = Some((sha256, bytes));
+        }
+        (joint.joint, report)
+    };
     outcome.timing.parse = parse_s;
-    let mut report = build_report(&input.read.log, &log, &opts, &outcome);
-    let (input_sha256, input_bytes) = match checksum {
+    report.timing_s.parse = parse_s;
+    let (input_sha256, input_bytes) = match checksums[0].take() {
         Some(c) => c,
-        None => sha256_of_input(&input.read.log).with_context(|| {
-            format!("cannot read {} for its checksum", input.read.log.display())
-        })?,
+        None => sha256_of_input(paths[0])
+            .with_context(|| format!("cannot read {} for its checksum", paths[0].display()))?,
     };
     report.provenance = Some(Provenance {
         command_line: std::env::args().collect::<Vec<_>>().join(" "),

@@ -7,6 +7,7 @@ use crate::terminal::errln;
 use anyhow::Context;
 use odocal_log::Log;
 use odocal_solver::Params;
+use std::path::{Path, PathBuf};
 
 /// The input log and the options of reading, pairing and matching it.
 #[derive(clap::Args, Debug)]
@@ -14,6 +15,11 @@ pub struct InputArgs {
     /// The log and how to read it.
     #[command(flatten)]
     pub read: ReadArgs,
+    /// Further logs of the same robot (any mix of Carmen logs, JSON logs and bags, read
+    /// with the same options), calibrated jointly with the first: each keeps its own
+    /// clock offset, health findings and scan pairs; the parameters are shared.
+    #[arg(value_name = "LOG")]
+    pub more_logs: Vec<PathBuf>,
     /// Pair scans K apart (default: about 0.4 s apart at the log's scan rate).
     #[arg(long, value_name = "K")]
     pub stride: Option<usize>,
@@ -49,9 +55,27 @@ impl InputArgs {
         self.nominal.as_deref().map(nominal_params).transpose()
     }
 
-    /// Reads the log with the reading options of [`ReadArgs`].
-    pub fn read_log(&self) -> anyhow::Result<Log> {
-        self.read.read_log()
+    /// Every log given, the first first.
+    pub fn paths(&self) -> Vec<&Path> {
+        std::iter::once(self.read.log.as_path())
+            .chain(self.more_logs.iter().map(PathBuf::as_path))
+            .collect()
+    }
+
+    /// Reads every log given, each with the reading options of [`ReadArgs`], with the
+    /// SHA-256 and size of each text log computed on the same single pass (`None` for a
+    /// bag; see [`ReadArgs::read_log_and_checksum`]).
+    pub fn read_logs(&self) -> anyhow::Result<Vec<(Log, Option<(String, u64)>)>> {
+        self.paths()
+            .into_iter()
+            .map(|path| {
+                ReadArgs {
+                    log: path.to_path_buf(),
+                    ..self.read.clone()
+                }
+                .read_log_and_checksum()
+            })
+            .collect()
     }
 }
 

@@ -1,5 +1,6 @@
-//! `odocal match LOG --out FILE`: synchronization and scan matching only; writes the
-//! samples as tuples (one JSON object per line).
+//! `odocal match LOG [LOG …] --out FILE`: synchronization and scan matching only;
+//! writes the samples (of every log, in the order given) as tuples (one JSON object
+//! per line).
 
 use crate::input::InputArgs;
 use crate::nominal::{describe, odometry_only_mode};
@@ -24,12 +25,17 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let input = &args.input;
     let pool = input.thread_pool()?;
-    check_file_output(&args.out, &input.read.log)
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
-    let mut log = input.read_log()?;
+    let paths = input.paths();
+    for log_path in &paths {
+        check_file_output(&args.out, log_path)
+            .with_context(|| format!("cannot write {}", args.out.display()))?;
+    }
+    let mut logs: Vec<_> = input.read_logs()?.into_iter().map(|(log, _)| log).collect();
     let initial_params = input.nominal()?;
-    if let Some(n) = odometry_only_mode(&input.read.log, &mut log, initial_params.as_ref())? {
-        errln!("{}", describe(&n));
+    for (path, log) in paths.iter().zip(logs.iter_mut()) {
+        if let Some(n) = odometry_only_mode(path, log, initial_params.as_ref())? {
+            errln!("{}: {}", path.display(), describe(&n));
+        }
     }
     let opts = Options {
         initial_params,
@@ -39,30 +45,45 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ..Options::default()
     };
     let bar = Bar::for_stderr();
-    let mut timing = Timing::default();
-    // The data-health stage repairs the log as `calibrate` does, and says what it did.
-    let (log, mut findings) = health::check_log(&log, &opts);
-    let synced = pool.install(|| synchronize_and_match(&log, &opts, &bar, &mut timing))?;
-    findings.extend(health::after_matching(&log, &synced, &opts));
-    for f in &findings {
-        errln!("{f}");
+    let mut samples = Vec::new();
+    for (path, log) in paths.iter().zip(&logs) {
+        let mut timing = Timing::default();
+        // The data-health stage repairs the log as `calibrate` does, and says what it did.
+        let (log, mut findings) = health::check_log(log, &opts);
+        let synced = pool
+            .install(|| synchronize_and_match(&log, &opts, &bar, &mut timing))
+            .with_context(|| format!("{}", path.display()))?;
+        findings.extend(health::after_matching(&log, &synced, &opts));
+        let name = if paths.len() > 1 {
+            format!("{}: ", path.display())
+        } else {
+            String::new()
+        };
+        for f in &findings {
+            errln!("{name}{f}");
+        }
+        let discarded: Vec<String> = synced
+            .discarded
+            .0
+            .iter()
+            .map(|(k, n)| format!("{k} {n}"))
+            .collect();
+        errln!(
+            "{name}{} samples ({} scan pairs, stride {}; discarded: {}); matching took {:.2} s",
+            synced.samples.len(),
+            synced.pairs,
+            synced.stride,
+            discarded.join(", "),
+            timing.r#match
+        );
+        samples.extend(synced.samples);
     }
-    write_tuples(&args.out, &synced.samples)
+    write_tuples(&args.out, &samples)
         .with_context(|| format!("cannot write {}", args.out.display()))?;
-    let discarded: Vec<String> = synced
-        .discarded
-        .0
-        .iter()
-        .map(|(k, n)| format!("{k} {n}"))
-        .collect();
     errln!(
-        "{} samples written to {} ({} scan pairs, stride {}; discarded: {}); matching took {:.2} s",
-        synced.samples.len(),
-        args.out.display(),
-        synced.pairs,
-        synced.stride,
-        discarded.join(", "),
-        timing.r#match
+        "{} samples written to {}",
+        samples.len(),
+        args.out.display()
     );
     Ok(())
 }

@@ -10,7 +10,7 @@ use odocal_log::{Log, Mode, ReadOptions};
 use std::path::PathBuf;
 
 /// The input log and the options of reading it.
-#[derive(clap::Args, Debug)]
+#[derive(clap::Args, Debug, Clone)]
 pub struct ReadArgs {
     /// The log: Carmen-style text, the original package's JSON log, or a ROS bag (ROS 1
     /// .bag, ROS 2 bag directory, .mcap or .db3). A text log may be a pipe or FIFO, or

@@ -9,10 +9,11 @@
 use crate::terminal::{errln, outln};
 use anyhow::Context;
 use odocal_regression::{
-    document, format_j_consistency, format_reproduction, format_summary, j_consistency,
-    kept_findings, load_sources, reproduce_from_text, reproduction_options, row_seed,
-    simulate_log_text, timing_line, umbmark_section, workspace_reference_dir, DocumentInputs,
-    JConsistency, Reproduction, RowTiming, Sources, Tolerances, J_PRINT_TOLERANCE,
+    document, format_j_consistency, format_reproduction, format_summary, j_consistency, join_parts,
+    kept_findings, load_sources, reproduce_from_text, reproduce_join_from_texts,
+    reproduction_options, row_seed, simulate_log_text, timing_line, umbmark_section,
+    workspace_reference_dir, DocumentInputs, JConsistency, Reproduction, RowTiming, Sources,
+    Tolerances, J_PRINT_TOLERANCE,
 };
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -62,6 +63,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for n in &sources.notes {
         errln!("note: {n}");
     }
+    let all_rows = sources.rows.clone();
     sources.select(&args.rows)?;
     let Sources { rows, table, notes } = sources;
     let pool = crate::input::thread_pool(args.threads)?;
@@ -74,15 +76,49 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let target = row.scaled_samples(args.samples_scale);
         let seed = row_seed(args.seed, &row.name);
         let t = Instant::now();
-        let text = simulate_log_text(&row.name, &row.truth(), target, seed)
-            .with_context(|| format!("simulating row '{}'", row.name))?;
-        let timing = RowTiming {
-            simulate: t.elapsed().as_secs_f64(),
-            log_mb: text.len() as f64 / 1e6,
+        let parts = join_parts(row, &all_rows, target);
+        let (rep, timing) = if parts.is_empty() {
+            let text = simulate_log_text(&row.name, &row.truth(), target, seed)
+                .with_context(|| format!("simulating row '{}'", row.name))?;
+            let timing = RowTiming {
+                simulate: t.elapsed().as_secs_f64(),
+                log_mb: text.len() as f64 / 1e6,
+            };
+            let rep = pool
+                .install(|| reproduce_from_text(row, target, &text, &opts))
+                .with_context(|| format!("calibrating the simulated log of row '{}'", row.name))?;
+            (rep, timing)
+        } else {
+            // A true join: one simulated log per component row, calibrated jointly.
+            let mut texts = Vec::with_capacity(parts.len());
+            for (part, n) in &parts {
+                let name = format!("{}.log (simulated, part of {})", part.name, row.name);
+                let text =
+                    simulate_log_text(&part.name, &row.truth(), *n, row_seed(seed, &part.name))
+                        .with_context(|| {
+                            format!("simulating part '{}' of row '{}'", part.name, row.name)
+                        })?;
+                texts.push((name, *n, text));
+            }
+            let timing = RowTiming {
+                simulate: t.elapsed().as_secs_f64(),
+                log_mb: texts.iter().map(|(_, _, t)| t.len()).sum::<usize>() as f64 / 1e6,
+            };
+            let rep = pool
+                .install(|| reproduce_join_from_texts(row, &texts, &opts))
+                .with_context(|| format!("calibrating the simulated logs of row '{}'", row.name))?;
+            let list: Vec<String> = parts
+                .iter()
+                .map(|(p, n)| format!("{} {n}", p.name))
+                .collect();
+            outln!(
+                "{}: a true join of {} simulated logs (samples asked: {})",
+                row.name,
+                parts.len(),
+                list.join(", ")
+            )?;
+            (rep, timing)
         };
-        let rep = pool
-            .install(|| reproduce_from_text(row, target, &text, &opts))
-            .with_context(|| format!("calibrating the simulated log of row '{}'", row.name))?;
         outln!("{}", format_reproduction(&rep, &tol))?;
         outln!("{}\n", timing_line(&rep, &timing))?;
         reproductions.push(rep);

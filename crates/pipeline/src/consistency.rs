@@ -70,7 +70,18 @@ pub fn check_halves(samples: &[Sample], options: &SolveOptions) -> Consistency {
     ) {
         (Ok(a), Ok(b)) => match undetermined_half(&a, &b, options) {
             Some(reason) => Consistency::NotAvailable { reason },
-            None => Consistency::Checked(Box::new(compare(&a, &b, options))),
+            None => {
+                let sum = std::array::from_fn(|i| {
+                    std::array::from_fn(|j| a.covariance[i][j] + b.covariance[i][j])
+                });
+                Consistency::Checked(Box::new(compare(
+                    &a,
+                    &b,
+                    &sum,
+                    options,
+                    "the two halves of the log",
+                )))
+            }
         },
         (Err(reason), _) | (_, Err(reason)) => Consistency::NotAvailable { reason },
     }
@@ -111,12 +122,20 @@ fn undetermined_half(a: &Calibration, b: &Calibration, options: &SolveOptions) -
     })
 }
 
-fn compare(a: &Calibration, b: &Calibration, options: &SolveOptions) -> HalvesCheck {
+/// Compares `a` with `b` given the covariance of their difference; `what` names the
+/// two in the sentence ("the two halves of the log").
+pub(crate) fn compare(
+    a: &Calibration,
+    b: &Calibration,
+    difference_covariance: &[[f64; 6]; 6],
+    options: &SolveOptions,
+    what: &str,
+) -> HalvesCheck {
     let difference = a.params.difference(&b.params);
     let free: Vec<usize> = (0..6)
         .filter(|&i| !options.constraints.is_held(i))
         .collect();
-    let combined = |i: usize, j: usize| a.covariance[i][j] + b.covariance[i][j];
+    let combined = |i: usize, j: usize| difference_covariance[i][j];
     let mut sigma = [0.0; 6];
     let mut z = [0.0; 6];
     for &i in &free {
@@ -143,11 +162,11 @@ fn compare(a: &Calibration, b: &Calibration, options: &SolveOptions) -> HalvesCh
     let agree = disagreeing.is_empty() && chi2 <= chi2_limit;
     let sentence = if agree {
         format!(
-            "the two halves of the log agree (χ² {chi2:.1} for {n} parameters, 3σ level {chi2_limit:.1}; largest difference {:.1}σ)",
+            "{what} agree (χ² {chi2:.1} for {n} parameters, 3σ level {chi2_limit:.1}; largest difference {:.1}σ)",
             free.iter().map(|&i| z[i].abs()).fold(0.0, f64::max)
         )
     } else {
-        disagreement_sentence(&free, &z, chi2, n, chi2_limit)
+        disagreement_sentence(what, &free, &z, chi2, n, chi2_limit)
     };
     HalvesCheck {
         samples_used: [a.samples_used, b.samples_used],
@@ -165,7 +184,14 @@ fn compare(a: &Calibration, b: &Calibration, options: &SolveOptions) -> HalvesCh
 
 /// "The halves disagree on …: likely …", naming the parameters beyond 3σ (or the
 /// largest ones when only χ² is beyond its level) and the causes that fit them.
-fn disagreement_sentence(free: &[usize], z: &[f64; 6], chi2: f64, n: usize, limit: f64) -> String {
+fn disagreement_sentence(
+    what: &str,
+    free: &[usize],
+    z: &[f64; 6],
+    chi2: f64,
+    n: usize,
+    limit: f64,
+) -> String {
     let mut named: Vec<usize> = free
         .iter()
         .copied()
@@ -198,7 +224,7 @@ fn disagreement_sentence(free: &[usize], z: &[f64; 6], chi2: f64, n: usize, limi
         vec![sweep, clock, slip, mounting]
     };
     format!(
-        "the two halves of the log disagree beyond 3σ ({}; χ² {chi2:.1} for {n} parameters, 3σ \
+        "{what} disagree beyond 3σ ({}; χ² {chi2:.1} for {n} parameters, 3σ \
          level {limit:.1}): something the model does not include changed or acts unevenly, so \
          the reported σ understate the error; likely causes: {}",
         list.join(", "),
@@ -313,12 +339,19 @@ mod tests {
     #[test]
     fn sentence_names_parameters_and_causes() {
         let z = [0.5, 0.4, 4.2, 1.0, 3.5, 0.2];
-        let s = disagreement_sentence(&[0, 1, 2, 3, 4, 5], &z, 40.0, 6, 20.06);
+        let s = disagreement_sentence("the halves", &[0, 1, 2, 3, 4, 5], &z, 40.0, 6, 20.06);
         assert!(s.contains("b by 4.2σ") && s.contains("l_y by 3.5σ"), "{s}");
         assert!(!s.contains("r_L"), "{s}");
         assert!(s.contains("sweeps") && s.contains("clock offset"), "{s}");
         assert!(s.contains("slip") && s.contains("mounting"), "{s}");
-        let radii = disagreement_sentence(&[0, 1], &[3.5, 3.2, 0.0, 0.0, 0.0, 0.0], 15.0, 2, 11.83);
+        let radii = disagreement_sentence(
+            "the halves",
+            &[0, 1],
+            &[3.5, 3.2, 0.0, 0.0, 0.0, 0.0],
+            15.0,
+            2,
+            11.83,
+        );
         assert!(radii.contains("likely causes: wheel slip"), "{radii}");
     }
 }

@@ -36,6 +36,8 @@ pub enum FindingKind {
     TwoHalves,
     /// Wheel counts read at times that vary around their timestamps.
     ReadJitter,
+    /// One log of a joint calibration against the joint estimate.
+    LogAgreement,
 }
 
 impl FindingKind {
@@ -55,6 +57,7 @@ impl FindingKind {
             FindingKind::Slip => "slip",
             FindingKind::TwoHalves => "two_halves",
             FindingKind::ReadJitter => "read_jitter",
+            FindingKind::LogAgreement => "log_agreement",
         }
     }
 }

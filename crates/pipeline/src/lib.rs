@@ -20,7 +20,8 @@
 //! notice), [`time_offset`] (optional clock-offset search), [`options`] (what the pipeline can be told),
 //! [`synchronized`] (the per-log samples between synchronization and the solve),
 //! [`run`] (the
-//! whole, with timing), [`samples`] (the samples and their tuples), [`estimate`] (the
+//! whole, with timing), [`joint`] (several logs of one robot, one calibration) and
+//! [`log_agreement`] (each of them against the joint estimate), [`samples`] (the samples and their tuples), [`estimate`] (the
 //! core numbers of a result).
 
 #![deny(missing_docs)]
@@ -33,6 +34,8 @@ pub mod estimate;
 pub mod finding;
 pub mod health;
 pub mod input_files;
+pub mod joint;
+pub mod log_agreement;
 pub mod matching;
 pub mod options;
 pub mod parallel;
@@ -50,6 +53,7 @@ pub use error::PipelineError;
 pub use estimate::Estimate;
 pub use finding::{Finding, FindingKind, Severity};
 pub use input_files::InputFiles;
+pub use joint::{calibrate_logs, Contribution, JointError, JointOutcome};
 pub use odocal_solver::Trim;
 pub use options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 pub use progress::{NoProgress, Progress};

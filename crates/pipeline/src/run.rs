@@ -356,6 +356,15 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         .collect();
     let solve_options = opts.solve_options();
     let calibration = odocal_solver::calibrate(&samples, &solve_options)?;
+    refuse_poorly_determined(calibration, &solve_options)
+}
+
+/// The calibration, or the refusal naming the parameters it does not determine well
+/// (unless weak parameters are accepted).
+pub(crate) fn refuse_poorly_determined(
+    calibration: Calibration,
+    solve_options: &SolveOptions,
+) -> Result<Calibration, PipelineError> {
     let poor: Vec<String> = calibration
         .observability
         .parameters

@@ -112,8 +112,11 @@ pub fn document(
          is simulated (`odocal-sim`, Khepera arena, mixed trajectory) with the row's \
          parameters as the truth, for about the row's number of samples at the default \
          stride, and the whole pipeline runs on the log text (read → synchronize → match → \
-         solve, default options: encoder profile, T-RO trimming, ML refinement). The \
-         recovered parameters are compared with the row.\n",
+         solve, default options: encoder profile, T-RO trimming, ML refinement). A joined \
+         row (k06-k15, k22-k29, k40-k45) is a true join: one log per component row of the \
+         table, each sized as its share of the joined row's samples, all with the joined \
+         row's parameters, calibrated jointly (each log with its own stages, one solve). \
+         The recovered parameters are compared with the row.\n",
         inputs.command,
         odocal_sim::EncoderConfig::default().ticks_per_revolution
     );

@@ -19,7 +19,8 @@
 //!   number of samples).
 //!
 //! One module each: [`table`] (published rows, table file), [`tro`] (T-RO reference),
-//! [`sources`] (the rows of a run), [`reproduce`] (simulation and pipeline),
+//! [`sources`] (the rows of a run), [`reproduce`] (simulation and pipeline), [`join`]
+//! (joined rows as joint calibrations of their simulated component logs),
 //! [`checks`] (the rules), [`consistency`] (printed J against eq. (2)), [`format`](mod@format)
 //! (Markdown tables), [`document`](mod@document) (`docs/table-i.md`).
 
@@ -29,6 +30,7 @@ pub mod checks;
 pub mod consistency;
 pub mod document;
 pub mod format;
+pub mod join;
 pub mod reproduce;
 pub mod sources;
 pub mod table;
@@ -45,6 +47,7 @@ pub use document::{
 pub use format::{
     format_j_consistency, format_reproduction, format_summary, format_umbmark, OdometryLine,
 };
+pub use join::{join_parts, reproduce_join_from_texts, MIN_COMPONENT_SAMPLES};
 pub use reproduce::{
     reproduce_from_text, reproduction_options, row_seed, simulate_log_text, Reproduction,
 };

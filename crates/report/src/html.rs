@@ -16,8 +16,9 @@ use serde_json::Value;
 const CSS: &str = include_str!("report.css");
 
 /// Top-level results.json keys shown in a section of their own.
-const SHOWN: [&str; 14] = [
+const SHOWN: [&str; 15] = [
     "log",
+    "logs",
     "r_l",
     "r_r",
     "b",
@@ -282,6 +283,13 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
                     h2 { "Parameters" }
                     (parameters(r, v))
                     p.note { "σ from the covariance of the estimate; verdicts from σ relative to the value (radii, b), to b (ℓx, ℓy), or in degrees (ℓθ)." }
+                }
+                @if let Some(logs) = v.get("logs") {
+                    section #logs {
+                        h2 { "Logs calibrated together" }
+                        p { "Each log's own estimate (own, own σ; m, rad), the samples it brought, its share of the information on r_L, r_R, b, ℓx, ℓy, ℓθ, and χ² of its own estimate against the joint one (agree: within 3σ)." }
+                        (json(logs, "/logs"))
+                    }
                 }
                 section #j-matrix {
                     h2 { "J matrix" }

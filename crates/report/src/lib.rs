@@ -1,5 +1,5 @@
 //! The report of a calibration: the human summary and `results.json` ([`report`]),
-//! where the run came from
+//! the joint report of several logs ([`joint`]), where the run came from
 //! ([`provenance`]), the figures ([`figures`], drawn with `plotters`), the one-page
 //! `results.html` ([`html`]) and the files `--out DIR` writes ([`output`]).
 //!
@@ -18,10 +18,12 @@
 
 pub mod figures;
 pub mod html;
+pub mod joint;
 pub mod output;
 pub mod provenance;
 pub mod report;
 
+pub use joint::{build_joint_report, LogRow};
 pub use odocal_pipeline::{Finding, FindingKind, Severity};
 pub use output::{html_report, is_output_name, write_html, write_outputs};
 pub use provenance::{sha256_of_input, Provenance};

@@ -85,6 +85,9 @@ pub struct Report {
     pub settings: Settings,
     /// Wall time per stage (s).
     pub timing_s: Timing,
+    /// With several logs calibrated together: one row per log.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub logs: Vec<crate::joint::LogRow>,
 }
 
 /// Counts from the log reader.
@@ -208,6 +211,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             accept_weak: opts.solve_options().accept_weak,
         },
         timing_s: e.timing_s,
+        logs: Vec::new(),
     }
 }
 
@@ -352,6 +356,9 @@ impl fmt::Display for Report {
                 "  correction factors (calibrated / nominal): r_L ×{:.6}, r_R ×{:.6}, b ×{:.6}",
                 c[0], c[1], c[2]
             )?;
+        }
+        if !self.logs.is_empty() {
+            crate::joint::write_log_table(f, &self.logs)?;
         }
         for finding in &self.checks {
             writeln!(f, "  {finding}")?;

@@ -1,0 +1,262 @@
+//! One robot, several logs, one calibration. Each log goes through the per-log
+//! stages on its own ([`calibrate_log`]: its time base, health findings, clock
+//! offset, sweep timing and scan pairs, and its own estimate, never refused); the
+//! joint stages then solve once over every log's samples (the parameters shared)
+//! and compare each log's own estimate with the joint one
+//! ([`crate::log_agreement`]). Data flow one way: logs → per-log outcomes → joint
+//! estimate.
+
+use crate::consistency::Consistency;
+use crate::error::PipelineError;
+use crate::finding::Finding;
+use crate::log_agreement::{check_log, information_shares};
+use crate::options::{Options, MIN_SAMPLES};
+use crate::progress::Progress;
+use crate::run::{calibrate_log, refuse_poorly_determined, Outcome, Timing};
+use crate::sync::DiscardCounts;
+use crate::synchronized::Synchronized;
+use odocal_log::Log;
+use odocal_solver::Sample;
+use serde::Serialize;
+use std::time::Instant;
+
+/// Gap (s) put between the time bases of consecutive logs in the joint solve, so
+/// that no scan of one log is taken for a scan of another (samples that share a
+/// scan are recognised by its timestamp).
+const LOG_TIME_GAP_S: f64 = 1000.0;
+
+/// What one log brought to the joint estimate.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Contribution {
+    /// Samples the log handed to the joint solve.
+    pub samples: usize,
+    /// Of them, the samples the joint estimate used (after trimming).
+    pub samples_used: usize,
+    /// Per parameter (r_L, r_R, b, ℓx, ℓy, ℓθ): the log's share of the information
+    /// (1/σ² of its own estimate over the sum of the logs').
+    pub information_share: [f64; 6],
+    /// The log's own estimate against the joint one.
+    pub agreement: Consistency,
+}
+
+/// The result of [`calibrate_logs`].
+#[derive(Debug, Clone)]
+pub struct JointOutcome {
+    /// Per log, in the order given: its own stages and estimate (solved with weak
+    /// parameters accepted: never judged, only compared).
+    pub logs: Vec<Outcome>,
+    /// The joint result: every log's findings (each prefixed with its log), samples
+    /// and discards together, the joint calibration and the summed timing. Its
+    /// `consistency` says that the logs are compared one by one instead of halves.
+    pub joint: Outcome,
+    /// Per log, in the same order: what it contributed and whether it agrees.
+    pub contributions: Vec<Contribution>,
+}
+
+/// Why [`calibrate_logs`] failed.
+#[derive(Debug, thiserror::Error)]
+pub enum JointError {
+    /// One log failed its own stages.
+    #[error("{name}: {source}")]
+    Log {
+        /// Index of the log in the order given.
+        index: usize,
+        /// The log's name as given.
+        name: String,
+        /// What failed.
+        source: PipelineError,
+    },
+    /// The joint solve failed or was refused.
+    #[error("the joint calibration of the logs: {0}")]
+    Joint(PipelineError),
+    /// The joint estimate was refused, and logs disagree with it: they do not
+    /// describe one robot with one mounting.
+    #[error(
+        "the logs do not describe one robot: {sentences}; calibrate them separately, or \
+         without the log(s) named (the joint estimate was refused: {refusal})"
+    )]
+    Disagree {
+        /// Each disagreeing log's sentence, joined.
+        sentences: String,
+        /// The joint refusal.
+        refusal: PipelineError,
+    },
+}
+
+/// Calibrates one robot from several logs: `logs` pairs each log with the name the
+/// messages give it (its path). Scan matching runs on rayon's current thread pool,
+/// one log after another (each log's pairs in parallel).
+pub fn calibrate_logs(
+    logs: &[(&str, &Log)],
+    opts: &Options,
+    progress: &dyn Progress,
+) -> Result<JointOutcome, JointError> {
+    let lenient = Options {
+        accept_weak: true,
+        ..opts.clone()
+    };
+    let mut outcomes = Vec::with_capacity(logs.len());
+    for (index, (name, log)) in logs.iter().enumerate() {
+        let outcome = calibrate_log(log, &lenient, progress).map_err(|source| JointError::Log {
+            index,
+            name: name.to_string(),
+            source,
+        })?;
+        outcomes.push(outcome);
+    }
+    let t = Instant::now();
+    let health: Vec<Finding> = logs
+        .iter()
+        .zip(&outcomes)
+        .flat_map(|((name, _), o)| {
+            o.health.iter().cloned().map(move |mut f| {
+                f.message = format!("{name}: {}", f.message);
+                f
+            })
+        })
+        .collect();
+    let samples = joint_samples(&outcomes, opts);
+    let synced = merged(&outcomes);
+    if samples.len() < MIN_SAMPLES {
+        return Err(JointError::Joint(PipelineError::TooFewSamples {
+            usable: samples.len(),
+            pairs: synced.pairs,
+            needed: MIN_SAMPLES,
+            discarded: synced.discarded,
+        }));
+    }
+    let solve_options = opts.solve_options();
+    let calibration = odocal_solver::calibrate(&samples, &solve_options)
+        .map_err(|e| JointError::Joint(PipelineError::from(e).with_faults(&health)))?;
+    let agreements: Vec<Consistency> = logs
+        .iter()
+        .zip(&outcomes)
+        .map(|((name, _), o)| check_log(&o.calibration, &calibration, &solve_options, name))
+        .collect();
+    let calibration = match refuse_poorly_determined(calibration, &solve_options) {
+        Ok(c) => c,
+        Err(refusal) => {
+            // Logs of different robots (or mountings) make one model fit none of them:
+            // the residuals grow and the joint verdicts weaken. Name the logs that
+            // disagree rather than ask for more driving.
+            let disagreeing: Vec<String> = agreements
+                .iter()
+                .filter_map(|a| match a {
+                    Consistency::Checked(h) if !h.agree => Some(h.sentence.clone()),
+                    _ => None,
+                })
+                .collect();
+            return Err(if disagreeing.is_empty() {
+                JointError::Joint(refusal.with_faults(&health))
+            } else {
+                JointError::Disagree {
+                    sentences: disagreeing.join("; "),
+                    refusal,
+                }
+            });
+        }
+    };
+    let own: Vec<_> = outcomes.iter().map(|o| &o.calibration).collect();
+    let shares = information_shares(&own);
+    let mut first = 0;
+    let contributions = logs
+        .iter()
+        .zip(&outcomes)
+        .zip(shares)
+        .zip(agreements)
+        .map(|(((_, o), information_share), agreement)| {
+            let n = o.synced.samples.len();
+            let used = calibration.used[first..first + n]
+                .iter()
+                .filter(|u| **u)
+                .count();
+            first += n;
+            Contribution {
+                samples: n,
+                samples_used: used,
+                information_share,
+                agreement,
+            }
+        })
+        .collect();
+    let mut timing = outcomes.iter().fold(Timing::default(), |a, o| Timing {
+        parse: a.parse + o.timing.parse,
+        sync: a.sync + o.timing.sync,
+        r#match: a.r#match + o.timing.r#match,
+        time_offset: a.time_offset + o.timing.time_offset,
+        solve: a.solve + o.timing.solve,
+    });
+    timing.solve += t.elapsed().as_secs_f64();
+    let joint = Outcome {
+        health,
+        synced,
+        calibration,
+        offset: None,
+        timing,
+        consistency: Consistency::NotAvailable {
+            reason: "several logs: each log's own estimate is compared with the joint one \
+                     instead"
+                .into(),
+        },
+    };
+    Ok(JointOutcome {
+        logs: outcomes,
+        joint,
+        contributions,
+    })
+}
+
+/// Every log's solver samples, in log order, each log with its own read-time noise,
+/// and the logs' scan times moved apart so that no two logs share a scan.
+fn joint_samples(outcomes: &[Outcome], opts: &Options) -> Vec<Sample> {
+    let mut samples = Vec::new();
+    let mut next_start = 0.0;
+    for o in outcomes {
+        let s = &o.synced;
+        let (lo, hi) = s
+            .samples
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p.pair.t0), hi.max(p.pair.t1))
+            });
+        let shift = if lo.is_finite() { next_start - lo } else { 0.0 };
+        samples.extend(s.samples.iter().map(|p| {
+            let sample = p.to_solver(opts.use_profile, opts.use_icp_covariance);
+            Sample {
+                read_time_sigma: s.read_time_sigma,
+                scan_times: sample.scan_times.map(|[a, b]| [a + shift, b + shift]),
+                ..sample
+            }
+        }));
+        if hi.is_finite() {
+            next_start = hi + shift + LOG_TIME_GAP_S;
+        }
+    }
+    samples
+}
+
+/// The logs' samples and discards together (stride, limits, ticks and clock offset
+/// of the first log: each log's own are in its outcome).
+fn merged(outcomes: &[Outcome]) -> Synchronized {
+    let mut discarded = DiscardCounts::default();
+    for o in outcomes {
+        for (k, n) in &o.synced.discarded.0 {
+            *discarded.0.entry(k).or_insert(0) += n;
+        }
+    }
+    let first = &outcomes[0].synced;
+    Synchronized {
+        stride: first.stride,
+        limits: first.limits,
+        ticks_per_revolution: first.ticks_per_revolution,
+        pairs: outcomes.iter().map(|o| o.synced.pairs).sum(),
+        samples: outcomes
+            .iter()
+            .flat_map(|o| o.synced.samples.iter().cloned())
+            .collect(),
+        discarded,
+        time_offset: first.time_offset,
+        sweep_compensated: outcomes.iter().any(|o| o.synced.sweep_compensated),
+        read_time_sigma: None,
+    }
+}
