@@ -155,6 +155,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 "odometry_only".into(),
                 serde_json::json!({
                     "nominal": {"r_l": nominal.r_l, "r_r": nominal.r_r, "b": nominal.b},
+                    "note": crate::nominal::ODOMETRY_ONLY_CAVEAT,
                     "correction_factors": {
                         "r_l": report.params.r_l / nominal.r_l,
                         "r_r": report.params.r_r / nominal.r_r,
