@@ -126,7 +126,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     opts.solve.constraints = args.partial.constraints()?;
 
     let bar = Bar::for_stderr();
-    let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
+    let mut outcome = pool
+        .install(|| calibrate_log(&log, &opts, &bar))
+        .map_err(crate::partial_args::with_hold_command)?;
     outcome.timing.parse = parse_s;
     let mut report = build_report(&input.read.log, &log, &opts, &outcome);
     let (input_sha256, input_bytes) = sha256_of_input(&input.read.log)

@@ -7,6 +7,7 @@ use crate::health;
 use crate::matching::{match_pairs, MatchStats};
 use crate::options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 use crate::progress::Progress;
+use crate::refusal;
 use crate::samples::PairSample;
 use crate::sweep::{compensated_pairs, has_sweep, reference_time};
 use crate::sync::{
@@ -366,6 +367,17 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         return Err(PipelineError::NotDetermined {
             parameters: poor,
             sentence: calibration.observability.sentence.clone(),
+            diagnosis: Box::new(refusal::Diagnosis {
+                causes: refusal::causes(&calibration, synced),
+                holds: refusal::holds(
+                    &samples,
+                    &solve_options,
+                    &calibration,
+                    opts.initial_params.as_ref(),
+                ),
+                caveat: None,
+                faults: None,
+            }),
         });
     }
     Ok(calibration)
