@@ -34,7 +34,7 @@ const SHOWN: [&str; 14] = [
 ];
 
 /// Keys of the "Data and solution" section, in order.
-const DATA_KEYS: [&str; 20] = [
+const DATA_KEYS: [&str; 21] = [
     "log_contents",
     "samples_used",
     "samples_synchronized",
@@ -46,6 +46,7 @@ const DATA_KEYS: [&str; 20] = [
     "ticks_per_revolution",
     "sm_sigma",
     "time_offset_s",
+    "time_offset_sigma_s",
     "cost_before",
     "cost_after",
     "observability",
