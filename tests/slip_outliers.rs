@@ -144,3 +144,35 @@ fn wheels_turning_while_the_robot_stands_are_named() {
         slip.message
     );
 }
+
+/// The report's end-of-path comparison leaves the slip out: with the wheels turning
+/// 2 s while the robot stands, the calibrated odometry ends closer to scan matching
+/// than the nominal one, and the caption says what was left out.
+#[test]
+fn report_compares_odometry_without_the_slip() {
+    let (path, _) = common::simulated_log("stand-report", "khepera", 60.0, 4, |c| {
+        c.faults.slip_per_minute = 1.0;
+        c.faults.slip_duration = [2.0, 2.0];
+        c.faults.slip_factor = [0.0, 0.0];
+    });
+    let html = path.with_extension("html");
+    let o = common::odocal(&[
+        "calibrate",
+        path.to_str().unwrap(),
+        "--report",
+        html.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    let page = std::fs::read_to_string(&html).expect("report written");
+    let at = page
+        .find("odometry with the calibrated parameters is ")
+        .expect("trajectory caption");
+    let caption = &page[at..at + 400];
+    let mm: Vec<f64> = caption
+        .split(" mm")
+        .filter_map(|p| p.rsplit(' ').next()?.parse().ok())
+        .collect();
+    assert!(caption.contains("flagged as slip left out"), "{caption}");
+    assert!(mm.len() >= 2 && mm[0] < mm[1], "{caption}");
+    common::cleanup(&path);
+}
