@@ -18,7 +18,7 @@ use crate::synchronized::Synchronized;
 use crate::time_offset::{estimate_time_offset, OffsetEstimate};
 use odocal_geom::Pose2;
 use odocal_log::{Log, ScanStore};
-use odocal_solver::{Calibration, Params, Predictor, SolveOptions, Verdict};
+use odocal_solver::{Calibration, Constraint, Params, Predictor, SolveOptions, Verdict};
 use std::borrow::Cow;
 use std::time::Instant;
 
@@ -271,6 +271,7 @@ pub fn synchronize_and_match(
         time_offset: opts.time_offset,
         sweep_compensated,
         read_time_sigma: None,
+        unrepaired_timing: None,
     })
 }
 
@@ -359,7 +360,19 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         })
         .collect();
     let solve_options = opts.solve_options();
-    let calibration = odocal_solver::calibrate(&samples, &solve_options)?;
+    let mut calibration = odocal_solver::calibrate(&samples, &solve_options)?;
+    if let Some(cause) = &synced.unrepaired_timing {
+        // Unrepaired timing: the σ do not hold what it does, so no verdict is "well
+        // determined"; the sentence names the cause.
+        for p in calibration.observability.parameters.iter_mut() {
+            if p.verdict == Verdict::WellDetermined && !matches!(p.constraint, Constraint::Held(_))
+            {
+                p.verdict = Verdict::Weak;
+            }
+        }
+        calibration.observability.sentence =
+            format!("{}; {cause}", calibration.observability.sentence);
+    }
     let poor: Vec<String> = calibration
         .observability
         .parameters
@@ -372,13 +385,20 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
             parameters: poor,
             sentence: calibration.observability.sentence.clone(),
             diagnosis: Box::new(refusal::Diagnosis {
-                causes: refusal::causes(&calibration, synced),
-                holds: refusal::holds(
-                    &samples,
-                    &solve_options,
-                    &calibration,
-                    opts.initial_params.as_ref(),
-                ),
+                causes: match &synced.unrepaired_timing {
+                    Some(cause) => vec![cause.clone()],
+                    None => refusal::causes(&calibration, synced),
+                },
+                // Holding parameters does not help against unrepaired timing.
+                holds: match synced.unrepaired_timing {
+                    Some(_) => Vec::new(),
+                    None => refusal::holds(
+                        &samples,
+                        &solve_options,
+                        &calibration,
+                        opts.initial_params.as_ref(),
+                    ),
+                },
                 caveat: None,
                 faults: None,
             }),
@@ -405,6 +425,12 @@ pub fn calibrate_log(
     let mut synced = synchronize_and_match(log, opts, progress, &mut timing)
         .map_err(|e| PipelineError::with_faults(e, &findings))?;
     synced.read_time_sigma = read_time_sigma;
+    if let Some(j) =
+        health::scan_jitter::estimate(&log.scans.scans, &log.encoders).filter(|j| j.detected())
+    {
+        findings.push(j.finding());
+        synced.unrepaired_timing = Some(j.cause());
+    }
     let found = health::clock_offset::found_offset(log, &synced, opts);
     let search_range = match (opts.estimate_time_offset, found) {
         (Some(range), _) => Some(range),

@@ -18,6 +18,7 @@ pub mod duplicates;
 pub mod frozen;
 pub mod gaps;
 pub mod read_jitter;
+pub mod scan_jitter;
 pub mod slip;
 pub mod spikes;
 pub mod wraps;
