@@ -111,9 +111,10 @@ fn all_determined(c: &Calibration) -> bool {
 }
 
 /// The fewest parameters (one, else two) that, held, leave every other parameter well
-/// determined, in [`HOLD_ORDER`] preference; empty when none does. Which ones is found
+/// determined, preferring ℓy, ℓx, ℓθ, b, then the radii; empty when none does. Which ones is found
 /// by holding them at the refused estimate (the σ of the rest barely depend on the
-/// held value); the values proposed come from [`known_value`].
+/// held value); the values proposed come from `--nominal`, the usual mounting (ℓy and
+/// ℓθ at 0), or are left to measure.
 pub fn holds(
     samples: &[Sample],
     options: &SolveOptions,
