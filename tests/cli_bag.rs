@@ -69,6 +69,33 @@ fn odometry_only_needs_the_nominal_parameters() {
 }
 
 #[test]
+fn nominal_values_in_millimetres_are_refused_and_odometry_only_states_its_caveat() {
+    let bag = "fixtures/bags/khepera_ros1_bz2_odom.bag";
+    let out = odocal(&["calibrate", bag, "--nominal", "21,21,88.4"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("metres") && err.contains("--nominal 0.021,0.021,0.0884"),
+        "{err}"
+    );
+    let out = odocal(&[
+        "calibrate",
+        bag,
+        "--nominal",
+        "0.021,0.021,0.0884",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let note = v["odometry_only"]["note"].as_str().unwrap_or_default();
+    assert!(note.contains("only as good as --nominal"), "{v}");
+}
+
+#[test]
 fn match_takes_the_nominal_parameters_of_odometry_only_input() {
     let bag = "fixtures/bags/khepera_ros1_bz2_odom.bag";
     let dir = common::temp_dir("match-nominal");

@@ -112,3 +112,67 @@ fn heavy_slip_is_never_wrong_and_well_determined() {
         }
     }
 }
+
+/// Wheels turning for 2 s while the robot stands (ground speed 0 on both wheels, so
+/// no rotation disagrees): the slip is named, in translation, at its time.
+#[test]
+fn wheels_turning_while_the_robot_stands_are_named() {
+    let mut config = SimConfig::preset("khepera").expect("preset");
+    config.duration = 60.0;
+    config.seed = 4;
+    config.faults.slip_per_minute = 1.0;
+    config.faults.slip_duration = [2.0, 2.0];
+    config.faults.slip_factor = [0.0, 0.0];
+    let run = simulate(&config).expect("simulation runs");
+    let mut bytes = Vec::new();
+    let summary = run.write_log(&mut bytes, &[]).expect("log written");
+    let truth = run.ground_truth(&summary);
+    let episode = &truth.faults.slip_intervals[0];
+    let episode = [episode.t_start, episode.t_end];
+    let log = read_carmen_from(&bytes[..], "stand.log", &ReadOptions::default()).expect("reads");
+    let out = calibrate_log(&log, &Options::default(), &NoProgress).expect("calibrates");
+    let slip = out
+        .health
+        .iter()
+        .find(|f| f.kind == odocal_pipeline::FindingKind::Slip)
+        .unwrap_or_else(|| panic!("no slip finding; slip at {episode:?}"));
+    assert!(slip.message.contains("in translation"), "{}", slip.message);
+    let at = slip.time.expect("a time");
+    assert!(
+        at > episode[0] - 1.0 && at < episode[1] + 1.0,
+        "found at {at:.1} s, slip at {episode:?}: {}",
+        slip.message
+    );
+}
+
+/// The report's end-of-path comparison leaves the slip out: with the wheels turning
+/// 2 s while the robot stands, the calibrated odometry ends closer to scan matching
+/// than the nominal one, and the caption says what was left out.
+#[test]
+fn report_compares_odometry_without_the_slip() {
+    let (path, _) = common::simulated_log("stand-report", "khepera", 60.0, 4, |c| {
+        c.faults.slip_per_minute = 1.0;
+        c.faults.slip_duration = [2.0, 2.0];
+        c.faults.slip_factor = [0.0, 0.0];
+    });
+    let html = path.with_extension("html");
+    let o = common::odocal(&[
+        "calibrate",
+        path.to_str().unwrap(),
+        "--report",
+        html.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    let page = std::fs::read_to_string(&html).expect("report written");
+    let at = page
+        .find("odometry with the calibrated parameters is ")
+        .expect("trajectory caption");
+    let caption = &page[at..at + 400];
+    let mm: Vec<f64> = caption
+        .split(" mm")
+        .filter_map(|p| p.rsplit(' ').next()?.parse().ok())
+        .collect();
+    assert!(caption.contains("flagged as slip left out"), "{caption}");
+    assert!(mm.len() >= 2 && mm[0] < mm[1], "{caption}");
+    common::cleanup(&path);
+}

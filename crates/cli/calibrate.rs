@@ -160,7 +160,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
     let bar = Bar::for_stderr();
     let (mut outcome, mut report) = if let [log] = &logs[..] {
-        let outcome = pool.install(|| calibrate_log(log, &opts, &bar))?;
+        let outcome = pool
+            .install(|| calibrate_log(log, &opts, &bar))
+            .map_err(crate::partial_args::with_hold_command)?;
         let report = build_report(paths[0], log, &opts, &outcome);
         (outcome, report)
     } else {
@@ -215,6 +217,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 "odometry_only".into(),
                 serde_json::json!({
                     "nominal": {"r_l": nominal.r_l, "r_r": nominal.r_r, "b": nominal.b},
+                    "note": crate::nominal::ODOMETRY_ONLY_CAVEAT,
                     "correction_factors": {
                         "r_l": report.params.r_l / nominal.r_l,
                         "r_r": report.params.r_r / nominal.r_r,

@@ -40,3 +40,37 @@ impl PartialArgs {
         Ok(c)
     }
 }
+
+/// A refusal that proposes parameters to hold, with the exact command to run: this
+/// command's own arguments and the `--fix` flags (`MEASURED` where the value must be
+/// measured). Other errors unchanged.
+pub fn with_hold_command(e: odocal_pipeline::PipelineError) -> anyhow::Error {
+    let holds = e.holds();
+    if holds.is_empty() {
+        return e.into();
+    }
+    let mut words: Vec<String> = vec!["odocal".into()];
+    words.extend(std::env::args().skip(1).map(|a| shell_word(&a)));
+    words.extend(holds.iter().map(|h| h.argument()));
+    let measure = if holds.iter().any(|h| h.value.is_none()) {
+        " (put the measured value in place of MEASURED)"
+    } else {
+        ""
+    };
+    anyhow::anyhow!(
+        "{e}\nto calibrate the other parameters, run{measure}:\n  {}",
+        words.join(" ")
+    )
+}
+
+/// An argument as a POSIX shell word (quoted when it holds anything but plain characters).
+fn shell_word(a: &str) -> String {
+    let plain = !a.is_empty()
+        && a.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./=,:+@%".contains(c));
+    if plain {
+        a.to_string()
+    } else {
+        format!("'{}'", a.replace('\'', "'\\''"))
+    }
+}

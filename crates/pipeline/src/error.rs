@@ -32,16 +32,22 @@ pub enum PipelineError {
     /// The solver returned numbers, but some parameters are so poorly determined
     /// (verdict "weak" or "not excited") that they would mislead.
     #[error(
-        "the data do not determine {} well enough: {sentence} (if some of them are known, hold \
-         them with --fix NAME=VALUE or give a prior with --prior NAME=VALUE±SIGMA, SI units; \
-         pass --accept-weak to see the numbers anyway)",
-        parameters.join(", ")
+        "the data do not determine {} well enough{}: {sentence}{}{} (if some of them are \
+         known, hold them with --fix NAME=VALUE or give a prior with --prior \
+         NAME=VALUE±SIGMA, SI units; pass --accept-weak to see the numbers anyway){}",
+        parameters.join(", "),
+        because(&diagnosis.causes),
+        holds_sentence(&diagnosis.holds),
+        caveat_sentence(&diagnosis.caveat),
+        also_found(&diagnosis.faults)
     )]
     NotDetermined {
         /// The parameters concerned (`r_L`, `r_R`, `b`, `l_x`, `l_y`, `l_theta`).
         parameters: Vec<String>,
         /// The solver's observability sentence: what motion is missing.
         sentence: String,
+        /// Its causes, the way out, and what else weakens the verdicts.
+        diagnosis: Box<crate::refusal::Diagnosis>,
     },
     /// Calibration failed, and the data-health stage found faults in the log that
     /// explain it: the faults come first, then what failed.
@@ -78,7 +84,23 @@ impl PipelineError {
         let Some(faults) = crate::finding::explain(findings).filter(|_| refusal) else {
             return self;
         };
-        let cause = match &self {
+        // The trajectory or the matching explains it: the faults are only also found.
+        let refused = match self {
+            PipelineError::NotDetermined {
+                parameters,
+                sentence,
+                mut diagnosis,
+            } if !diagnosis.causes.is_empty() => {
+                diagnosis.faults = Some(faults);
+                return PipelineError::NotDetermined {
+                    parameters,
+                    sentence,
+                    diagnosis,
+                };
+            }
+            other => other,
+        };
+        let cause = match &refused {
             PipelineError::TooFewSamples {
                 usable,
                 pairs,
@@ -94,9 +116,44 @@ impl PipelineError {
         PipelineError::DataFault {
             faults,
             cause,
-            refusal: Box::new(self),
+            refusal: Box::new(refused),
         }
     }
+
+    /// The parameters to hold that the refusal proposes (through a data-fault wrapper).
+    pub fn holds(&self) -> &[crate::refusal::Hold] {
+        match self {
+            PipelineError::NotDetermined { diagnosis, .. } => &diagnosis.holds,
+            PipelineError::DataFault { refusal, .. } => refusal.holds(),
+            _ => &[],
+        }
+    }
+}
+
+fn because(causes: &[String]) -> String {
+    if causes.is_empty() {
+        String::new()
+    } else {
+        format!(" because {}", causes.join(", and "))
+    }
+}
+
+fn holds_sentence(holds: &[crate::refusal::Hold]) -> String {
+    if holds.is_empty() {
+        String::new()
+    } else {
+        format!("; {}", crate::refusal::describe_holds(holds))
+    }
+}
+
+fn caveat_sentence(caveat: &Option<String>) -> String {
+    caveat.as_ref().map_or(String::new(), |c| format!("; {c}"))
+}
+
+fn also_found(faults: &Option<String>) -> String {
+    faults.as_ref().map_or(String::new(), |f| {
+        format!("; also found in the log (not the cause): {f}")
+    })
 }
 
 fn describe_discards(d: &DiscardCounts) -> String {

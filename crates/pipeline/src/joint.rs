@@ -133,29 +133,30 @@ pub fn calibrate_logs(
         .zip(&outcomes)
         .map(|((name, _), o)| check_log(&o.calibration, &calibration, &solve_options, name))
         .collect();
-    let calibration = match refuse_poorly_determined(calibration, &solve_options) {
-        Ok(c) => c,
-        Err(refusal) => {
-            // Logs of different robots (or mountings) make one model fit none of them:
-            // the residuals grow and the joint verdicts weaken. Name the logs that
-            // disagree rather than ask for more driving.
-            let disagreeing: Vec<String> = agreements
-                .iter()
-                .filter_map(|a| match a {
-                    Consistency::Checked(h) if !h.agree => Some(h.sentence.clone()),
-                    _ => None,
-                })
-                .collect();
-            return Err(if disagreeing.is_empty() {
-                JointError::Joint(refusal.with_faults(&health))
-            } else {
-                JointError::Disagree {
-                    sentences: disagreeing.join("; "),
-                    refusal,
-                }
-            });
-        }
-    };
+    let calibration =
+        match refuse_poorly_determined(calibration, &synced, &samples, &solve_options, opts) {
+            Ok(c) => c,
+            Err(refusal) => {
+                // Logs of different robots (or mountings) make one model fit none of them:
+                // the residuals grow and the joint verdicts weaken. Name the logs that
+                // disagree rather than ask for more driving.
+                let disagreeing: Vec<String> = agreements
+                    .iter()
+                    .filter_map(|a| match a {
+                        Consistency::Checked(h) if !h.agree => Some(h.sentence.clone()),
+                        _ => None,
+                    })
+                    .collect();
+                return Err(if disagreeing.is_empty() {
+                    JointError::Joint(refusal.with_faults(&health))
+                } else {
+                    JointError::Disagree {
+                        sentences: disagreeing.join("; "),
+                        refusal,
+                    }
+                });
+            }
+        };
     let own: Vec<_> = outcomes.iter().map(|o| &o.calibration).collect();
     let shares = information_shares(&own);
     let mut first = 0;
@@ -258,5 +259,13 @@ fn merged(outcomes: &[Outcome]) -> Synchronized {
         time_offset: first.time_offset,
         sweep_compensated: outcomes.iter().any(|o| o.synced.sweep_compensated),
         read_time_sigma: None,
+        // One log's unrepaired timing weakens the joint verdicts too.
+        unrepaired_timing: {
+            let causes: Vec<&str> = outcomes
+                .iter()
+                .filter_map(|o| o.synced.unrepaired_timing.as_deref())
+                .collect();
+            (!causes.is_empty()).then(|| causes.join("; "))
+        },
     }
 }

@@ -40,6 +40,7 @@ pub mod matching;
 pub mod options;
 pub mod parallel;
 mod progress;
+pub mod refusal;
 pub mod run;
 pub mod samples;
 pub mod sweep;

@@ -7,6 +7,7 @@ use crate::health;
 use crate::matching::{match_pairs, MatchStats};
 use crate::options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 use crate::progress::Progress;
+use crate::refusal;
 use crate::samples::PairSample;
 use crate::sweep::{compensated_pairs, has_sweep, reference_time};
 use crate::sync::{
@@ -17,9 +18,13 @@ use crate::synchronized::Synchronized;
 use crate::time_offset::{estimate_time_offset, OffsetEstimate};
 use odocal_geom::Pose2;
 use odocal_log::{Log, ScanStore};
-use odocal_solver::{Calibration, Params, Predictor, SolveOptions, Verdict};
+use odocal_solver::{Calibration, Constraint, Params, Predictor, SolveOptions, Verdict};
 use std::borrow::Cow;
 use std::time::Instant;
+
+/// Half-width (s) of the second clock-offset search of a swept log, around the first
+/// estimate, once the sweep is compensated at it.
+pub const REESTIMATE_RANGE_S: f64 = 0.05;
 
 /// Wall time per stage (s).
 #[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
@@ -267,6 +272,7 @@ pub fn synchronize_and_match(
         time_offset: opts.time_offset,
         sweep_compensated,
         read_time_sigma: None,
+        unrepaired_timing: None,
     })
 }
 
@@ -356,15 +362,31 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         .collect();
     let solve_options = opts.solve_options();
     let calibration = odocal_solver::calibrate(&samples, &solve_options)?;
-    refuse_poorly_determined(calibration, &solve_options)
+    refuse_poorly_determined(calibration, synced, &samples, &solve_options, opts)
 }
 
-/// The calibration, or the refusal naming the parameters it does not determine well
-/// (unless weak parameters are accepted).
+/// The calibration, or the refusal naming the parameters it does not determine well,
+/// with their causes and the parameters to hold (unless weak parameters are
+/// accepted). With unrepaired timing in the data no verdict is "well determined".
 pub(crate) fn refuse_poorly_determined(
-    calibration: Calibration,
+    mut calibration: Calibration,
+    synced: &Synchronized,
+    samples: &[odocal_solver::Sample],
     solve_options: &SolveOptions,
+    opts: &Options,
 ) -> Result<Calibration, PipelineError> {
+    if let Some(cause) = &synced.unrepaired_timing {
+        // Unrepaired timing: the σ do not hold what it does, so no verdict is "well
+        // determined"; the sentence names the cause.
+        for p in calibration.observability.parameters.iter_mut() {
+            if p.verdict == Verdict::WellDetermined && !matches!(p.constraint, Constraint::Held(_))
+            {
+                p.verdict = Verdict::Weak;
+            }
+        }
+        calibration.observability.sentence =
+            format!("{}; {cause}", calibration.observability.sentence);
+    }
     let poor: Vec<String> = calibration
         .observability
         .parameters
@@ -376,6 +398,24 @@ pub(crate) fn refuse_poorly_determined(
         return Err(PipelineError::NotDetermined {
             parameters: poor,
             sentence: calibration.observability.sentence.clone(),
+            diagnosis: Box::new(refusal::Diagnosis {
+                causes: match &synced.unrepaired_timing {
+                    Some(cause) => vec![cause.clone()],
+                    None => refusal::causes(&calibration, synced),
+                },
+                // Holding parameters does not help against unrepaired timing.
+                holds: match synced.unrepaired_timing {
+                    Some(_) => Vec::new(),
+                    None => refusal::holds(
+                        samples,
+                        &solve_options,
+                        &calibration,
+                        opts.initial_params.as_ref(),
+                    ),
+                },
+                caveat: None,
+                faults: None,
+            }),
         });
     }
     Ok(calibration)
@@ -403,6 +443,12 @@ pub fn calibrate_log(
     let mut synced = synchronize_and_match(log, opts, progress, &mut timing)
         .map_err(|e| PipelineError::with_faults(e, &findings))?;
     synced.read_time_sigma = read_time_sigma;
+    if let Some(j) =
+        health::scan_jitter::estimate(&log.scans.scans, &log.encoders).filter(|j| j.detected())
+    {
+        findings.push(j.finding());
+        synced.unrepaired_timing = Some(j.cause());
+    }
     let found = health::clock_offset::found_offset(log, &synced, opts);
     let search_range = match (opts.estimate_time_offset, found) {
         (Some(range), _) => Some(range),
@@ -443,25 +489,38 @@ pub fn calibrate_log(
         timing.time_offset += t.elapsed().as_secs_f64();
         offset = Some(est);
     }
-    // Slip is judged at the offset finally used.
-    findings.extend(health::slip::episodes(log, &synced));
-
     let t_solve = Instant::now();
-    // With a sweep this estimate only compensates the sweep again (at the offset now
-    // used): the verdicts are those of the final solve.
-    let first = if sweep { &lenient } else { opts };
-    let mut calibration =
-        solve(&synced, first).map_err(|e| PipelineError::with_faults(e, &findings))?;
-    timing.solve += t_solve.elapsed().as_secs_f64();
-
     if opts.second_pass || sweep {
+        // This estimate only gives the second pass its first guesses and, with a
+        // sweep, compensates the sweep again at the offset now used: the verdicts are
+        // those of the final solve.
+        let first =
+            solve(&synced, &lenient).map_err(|e| PipelineError::with_faults(e, &findings))?;
+        timing.solve += t_solve.elapsed().as_secs_f64();
         let t = Instant::now();
-        second_pass(log, &mut synced, &calibration.params, opts, progress);
+        second_pass(log, &mut synced, &first.params, opts, progress);
         timing.r#match += t.elapsed().as_secs_f64();
-        let t = Instant::now();
-        calibration = solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
-        timing.solve += t.elapsed().as_secs_f64();
+        if let (true, Some(est)) = (sweep, offset.as_ref()) {
+            // The offset was estimated on scans compensated at the starting offset
+            // (2.5 ms low on 80 ms-offset TurtleBot logs): estimated again, near it,
+            // on the scans compensated at it.
+            let t = Instant::now();
+            let base =
+                solve(&synced, &lenient).map_err(|e| PipelineError::with_faults(e, &findings))?;
+            let again =
+                estimate_time_offset(log, &synced, opts, est.offset, REESTIMATE_RANGE_S, &base)?;
+            resynchronize(log, &mut synced, again.offset);
+            offset = Some(again);
+            timing.time_offset += t.elapsed().as_secs_f64();
+        }
     }
+    // Slip is judged on the final samples: at the offset finally used and, with a
+    // sweep, on the scans compensated at it (before, the offset and the sweep left
+    // rotation residuals that were called slip).
+    findings.extend(health::slip::episodes(log, &synced));
+    let t = Instant::now();
+    let calibration = solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
+    timing.solve += t.elapsed().as_secs_f64();
 
     let t = Instant::now();
     let samples: Vec<_> = synced

@@ -29,4 +29,7 @@ pub struct Synchronized {
     /// smoothing, when they were read at jittery times (see
     /// [`crate::health::read_jitter`]); the solver's covariance accounts for it.
     pub read_time_sigma: Option<f64>,
+    /// A timing fault nothing repairs (see [`crate::health::scan_jitter`]), in words:
+    /// while it is set no parameter is judged well determined.
+    pub unrepaired_timing: Option<String>,
 }

@@ -33,6 +33,8 @@ pub const MAX_GRID_STEPS: usize = 500;
 pub const MAX_RANGE_OF_SPAN: f64 = 0.5;
 /// Squared normalized residuals are capped at this value.
 const CAP: f64 = 25.0;
+/// Half-width (s) of the three-point curvature of the cost at the estimate.
+pub const CURVATURE_STEP_S: f64 = 0.005;
 
 /// The result of the search.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -43,6 +45,10 @@ pub struct OffsetEstimate {
     pub cost: f64,
     /// Cost at the starting offset (on the coarse grid's samples).
     pub cost_at_start: f64,
+    /// Standard deviation of the offset (s) from the curvature of the profile cost
+    /// (the parameters re-solved at each offset), taking the samples as independent;
+    /// `None` when the cost is not convex there.
+    pub sigma: Option<f64>,
     /// The coarse grid: (offset s, cost on its subsample of the samples).
     pub grid: Vec<(f64, f64)>,
 }
@@ -152,6 +158,19 @@ impl Problem<'_> {
     }
 }
 
+impl Problem<'_> {
+    /// σ of the offset from the cost's curvature at `offset`. The cost is the mean of
+    /// the N samples' normalized squared residuals (≈ χ² with 3 degrees of freedom
+    /// each), so the negative log-likelihood is N·cost/2 and the offset's variance
+    /// 2 / (N·cost''), the parameters being re-solved at each offset (profile).
+    fn sigma_at(&self, offset: f64, cost: f64) -> Option<f64> {
+        let h = CURVATURE_STEP_S;
+        let n = self.samples_at(offset, 1).len() as f64;
+        let second = (self.cost(offset - h, 1) - 2.0 * cost + self.cost(offset + h, 1)) / (h * h);
+        (second.is_finite() && second > 0.0 && n > 0.0).then(|| (2.0 / (n * second)).sqrt())
+    }
+}
+
 /// Searches the offset within `start ± range` (s).
 pub fn estimate_time_offset(
     log: &Log,
@@ -225,6 +244,7 @@ pub fn estimate_time_offset(
     if best_full < cost {
         (offset, cost) = (best, best_full);
     }
+    let sigma = problem.sigma_at(offset, cost);
     let cost_at_start = grid
         .iter()
         .find(|(d, _)| (*d - start).abs() < 1e-12)
@@ -234,6 +254,7 @@ pub fn estimate_time_offset(
         offset,
         cost,
         cost_at_start,
+        sigma,
         grid,
     })
 }

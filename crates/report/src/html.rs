@@ -35,7 +35,7 @@ const SHOWN: [&str; 15] = [
 ];
 
 /// Keys of the "Data and solution" section, in order.
-const DATA_KEYS: [&str; 20] = [
+const DATA_KEYS: [&str; 21] = [
     "log_contents",
     "samples_used",
     "samples_synchronized",
@@ -47,6 +47,7 @@ const DATA_KEYS: [&str; 20] = [
     "ticks_per_revolution",
     "sm_sigma",
     "time_offset_s",
+    "time_offset_sigma_s",
     "cost_before",
     "cost_after",
     "observability",

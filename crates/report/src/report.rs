@@ -64,6 +64,10 @@ pub struct Report {
     /// Estimated clock offset (s, laser clock minus encoder clock), when asked.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_s: Option<f64>,
+    /// Standard deviation (s) of the estimated clock offset, from the curvature of the
+    /// offset search's cost, when it is convex there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_offset_sigma_s: Option<f64>,
     /// The nominal parameters given (`--nominal`), order r_L, r_R, b, ℓx, ℓy, ℓθ.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub nominal: Option<[f64; 6]>,
@@ -180,6 +184,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         consistency: outcome.consistency.clone(),
         shared_scan_noise: c.shared_scan_noise,
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
+        time_offset_sigma_s: outcome.offset.as_ref().and_then(|o| o.sigma),
         nominal: opts.initial_params.map(|p| p.to_vector()),
         correction_factors: opts
             .initial_params
@@ -344,10 +349,12 @@ impl fmt::Display for Report {
             )?;
         }
         if let Some(t) = self.time_offset_s {
+            let sigma = self
+                .time_offset_sigma_s
+                .map_or(String::new(), |s| format!(" ± {s:.4} s"));
             writeln!(
                 f,
-                "  clock offset (laser clock − encoder clock): {:+.4} s",
-                t
+                "  clock offset (laser clock − encoder clock): {t:+.4} s{sigma}"
             )?;
         }
         if let Some(c) = self.correction_factors {

@@ -20,6 +20,7 @@ pub mod frozen;
 pub mod gaps;
 pub mod plausibility;
 pub mod read_jitter;
+pub mod scan_jitter;
 pub mod slip;
 pub mod spikes;
 pub mod wraps;

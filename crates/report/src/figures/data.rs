@@ -33,6 +33,8 @@ pub struct FigureData<'a> {
     pub spans: Vec<(f64, f64, FindingKind)>,
     /// Kinds of motion nearly absent.
     pub missing: Vec<&'static str>,
+    /// Per sample: flagged as slip (wheels and scans disagree).
+    pub slipped: Vec<bool>,
 }
 
 /// Parameters a user would start from without calibration, when no nominal ones are
@@ -93,8 +95,15 @@ impl<'a> FigureData<'a> {
             .chain(&report.checks)
             .flat_map(|f| f.spans.iter().map(|s| (s[0] - t0, s[1] - t0, f.kind)))
             .collect();
+        let slip_flags = flagged(&outcome.synced);
+        let mut slipped = vec![false; pairs.len()];
+        for &k in &slip_flags {
+            if let Some(s) = slipped.get_mut(k) {
+                *s = true;
+            }
+        }
         if report.health.iter().any(|f| f.kind == FindingKind::Slip) {
-            spans.extend(slip_spans(pairs, &flagged(&outcome.synced), t0));
+            spans.extend(slip_spans(pairs, &slip_flags, t0));
         }
         FigureData {
             pairs,
@@ -108,6 +117,7 @@ impl<'a> FigureData<'a> {
             sm_sigma: c.sm_sigma,
             spans,
             missing: c.observability.motion.missing(),
+            slipped,
         }
     }
 
@@ -130,6 +140,20 @@ impl<'a> FigureData<'a> {
                 .iter()
                 .map(|s| Pose2::from_array(predictor.predict(s))),
         )
+    }
+
+    /// The sensor path by odometry with `params`, except over the samples flagged as
+    /// slip, where it follows scan matching: where the wheels slipped no parameters
+    /// give the right odometry, so those samples would only blur a comparison.
+    pub fn odometry_path_without_slip(&self, params: &Params) -> Vec<(f64, f64)> {
+        let predictor = Predictor::new(params, self.use_profile);
+        Self::chain(self.samples.iter().zip(&self.slipped).map(|(s, slip)| {
+            if *slip {
+                s.sm
+            } else {
+                Pose2::from_array(predictor.predict(s))
+            }
+        }))
     }
 
     /// The sensor path by chained scan matching.

@@ -38,6 +38,27 @@ pub fn figure(d: &FigureData) -> Result<Figure, DrawError> {
         let (a, b) = (end(p), end(&sm));
         ((a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)).sqrt()
     };
+    // The end distances compare the parameters: samples flagged as slip follow scan
+    // matching in all three paths, else a slip would count against any calibration.
+    let slips = d.slipped.iter().filter(|s| **s).count();
+    let (calibrated_end, nominal_end) = if slips > 0 {
+        (
+            drift(&d.odometry_path_without_slip(&d.params)),
+            drift(&d.odometry_path_without_slip(&d.nominal.0)),
+        )
+    } else {
+        (drift(&calibrated), drift(&nominal))
+    };
+    let excluded = if slips > 0 {
+        format!(
+            " ({slips} sample(s) flagged as slip left out of this comparison: the paths \
+             drawn include them, {:.1} mm and {:.1} mm)",
+            1e3 * drift(&calibrated),
+            1e3 * drift(&nominal)
+        )
+    } else {
+        String::new()
+    };
     let svg = svg(HEIGHT, |root| {
         let (plot, legend) = root.split_horizontally(WIDTH - LEGEND_W);
         let mut chart = xy_chart(&plot, xr, yr, "x (m)", "y (m)")?;
@@ -83,11 +104,11 @@ pub fn figure(d: &FigureData) -> Result<Figure, DrawError> {
         caption: format!(
             "The laser's path from chaining the {} samples' displacements. At the end, \
              odometry with the calibrated parameters is {:.1} mm from scan matching, with the \
-             nominal ones ({}) {:.1} mm.",
+             nominal ones ({}) {:.1} mm{excluded}.",
             d.samples.len(),
-            1e3 * drift(&calibrated),
+            1e3 * calibrated_end,
             d.nominal.1.trim_start_matches("odometry, "),
-            1e3 * drift(&nominal)
+            1e3 * nominal_end
         ),
         svg,
     })
