@@ -60,7 +60,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 /// `odocal info BAG`.
 fn bag_info(args: &Args) -> anyhow::Result<()> {
-    let info = inspect_bag(&args.read.log, &args.read.bag_options())
+    let info = inspect_bag(&args.read.log, &args.read.bag_options()?)
         .map_err(|e| anyhow::anyhow!("{e}"))?;
     let (choice, summary) = match &info.calibration {
         Ok((sel, log)) => (Ok(sel), Some(LogSummary::of(log))),

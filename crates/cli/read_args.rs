@@ -12,7 +12,8 @@ use std::path::PathBuf;
 #[derive(clap::Args, Debug)]
 pub struct ReadArgs {
     /// The log: Carmen-style text, the original package's JSON log, or a ROS bag (ROS 1
-    /// .bag, ROS 2 bag directory, .mcap or .db3).
+    /// .bag, ROS 2 bag directory or its metadata.yaml, .mcap or .db3).
+    #[arg(value_parser = log_path)]
     pub log: PathBuf,
     /// Bag: the sensor_msgs/LaserScan topic (default: the only one).
     #[arg(long, value_name = "TOPIC")]
@@ -24,8 +25,8 @@ pub struct ReadArgs {
     #[arg(long, value_name = "TOPIC")]
     pub odom_topic: Option<String>,
     /// Bag: the left and right wheel joint names (default: the only joints named like a
-    /// left and a right wheel).
-    #[arg(long, value_name = "LEFT,RIGHT", value_delimiter = ',', num_args = 2)]
+    /// left and a right wheel). `LEFT,RIGHT` or `LEFT RIGHT`.
+    #[arg(long, value_name = "LEFT,RIGHT", value_delimiter = ',', num_args = 1..=2)]
     pub wheel_joints: Option<Vec<String>>,
     /// Bag: stamp messages with the bag's record time instead of their header stamp.
     #[arg(long)]
@@ -64,18 +65,15 @@ impl ReadArgs {
         }
     }
 
-    /// The bag reading options these arguments ask for.
-    pub fn bag_options(&self) -> BagOptions {
-        BagOptions {
+    /// The bag reading options these arguments ask for; an error when `--wheel-joints`
+    /// does not name exactly two joints.
+    pub fn bag_options(&self) -> anyhow::Result<BagOptions> {
+        Ok(BagOptions {
             choice: TopicChoice {
                 scan_topic: self.scan_topic.clone(),
                 joint_states_topic: self.joint_states_topic.clone(),
                 odom_topic: self.odom_topic.clone(),
-                wheel_joints: self
-                    .wheel_joints
-                    .as_ref()
-                    .filter(|v| v.len() == 2)
-                    .map(|v| (v[0].clone(), v[1].clone())),
+                wheel_joints: self.wheel_joints()?,
             },
             clock: if self.use_receive_time {
                 Clock::Receive
@@ -83,6 +81,23 @@ impl ReadArgs {
                 Clock::Header
             },
             read: self.read_options(),
+        })
+    }
+
+    /// The two joints of `--wheel-joints` (left, right), or an error naming what was given.
+    fn wheel_joints(&self) -> anyhow::Result<Option<(String, String)>> {
+        match self.wheel_joints.as_deref() {
+            None => Ok(None),
+            Some([left, right]) if !left.is_empty() && !right.is_empty() => {
+                Ok(Some((left.clone(), right.clone())))
+            }
+            Some(given) => anyhow::bail!(
+                "--wheel-joints takes two joint names, the left and the right wheel's: \
+                 `--wheel-joints LEFT,RIGHT` (e.g. --wheel-joints \
+                 wheel_left_joint,wheel_right_joint); got {} value(s): {:?}",
+                given.len(),
+                given
+            ),
         }
     }
 
@@ -105,7 +120,7 @@ impl ReadArgs {
                 );
             }
             let bag =
-                read_bag(&self.log, &self.bag_options()).map_err(|e| anyhow::anyhow!("{e}"))?;
+                read_bag(&self.log, &self.bag_options()?).map_err(|e| anyhow::anyhow!("{e}"))?;
             for r in &bag.selection.reasons {
                 eprintln!("{r}");
             }
@@ -125,5 +140,20 @@ impl ReadArgs {
         }
         // The reader's message already says everything (file, line, cause).
         read_log(&self.log, &self.read_options()).map_err(|e| anyhow::anyhow!("{e}"))
+    }
+}
+
+/// The input path as given, except that a ROS 2 bag's `metadata.yaml` stands for its
+/// bag directory (the bag is the directory, not the YAML file).
+fn log_path(arg: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(arg);
+    let is_metadata = path.file_name().is_some_and(|n| n == "metadata.yaml");
+    match path.parent() {
+        Some(dir) if is_metadata && path.is_file() => Ok(if dir.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            dir.to_path_buf()
+        }),
+        _ => Ok(path),
     }
 }

@@ -1,0 +1,102 @@
+//! The command line as a ROS user meets it: `--wheel-joints LEFT,RIGHT` as the help
+//! gives it, a ROS 2 bag named by its `metadata.yaml`, `info` on a bag with the
+//! data-health findings and bag vocabulary, advice that names only flags the command
+//! takes, refusals under `--json` as a JSON object, and the results in ROS terms.
+
+mod common;
+
+use common::{odocal, stderr};
+use std::path::Path;
+
+fn root(path: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join(path)
+        .to_string_lossy()
+        .into_owned()
+}
+
+fn stdout(o: &std::process::Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+#[test]
+fn wheel_joints_take_the_comma_form_the_help_gives_and_refuse_anything_else() {
+    let bag = root("fixtures/bags/turtlebot_lds.bag");
+    for form in [
+        vec!["--wheel-joints", "wheel_left_joint,wheel_right_joint"],
+        vec!["--wheel-joints", "wheel_left_joint", "wheel_right_joint"],
+    ] {
+        let mut args = vec!["info", bag.as_str(), "--json"];
+        args.extend(form.iter().copied());
+        let out = odocal(&args);
+        assert!(out.status.success(), "{form:?}: {}", stderr(&out));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["calibration_uses"]["wheels"]["left"], "wheel_left_joint");
+        assert_eq!(
+            v["calibration_uses"]["wheels"]["right"],
+            "wheel_right_joint"
+        );
+    }
+    for bad in [
+        vec!["--wheel-joints", "a,b", "c,d"],
+        vec!["--wheel-joints", "wheel_left_joint"],
+        vec!["--wheel-joints", "a,b,c"],
+    ] {
+        let mut args = vec!["info", bag.as_str()];
+        args.extend(bad.iter().copied());
+        let out = odocal(&args);
+        assert!(!out.status.success(), "{bad:?} accepted");
+        let err = stderr(&out);
+        assert!(err.contains("--wheel-joints"), "{bad:?}: {err}");
+    }
+}
+
+#[test]
+fn a_ros2_bag_named_by_its_metadata_yaml_is_read_as_its_directory() {
+    let out = odocal(&[
+        "info",
+        &root("fixtures/bags/khepera_ros2_dir/metadata.yaml"),
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let scan_type = v["topics"]["/scan"]["type"].as_str().unwrap_or("");
+    assert!(scan_type.ends_with("LaserScan"), "{v}");
+    assert!(v["scans"].as_u64().unwrap() > 50, "{v}");
+}
+
+#[test]
+fn match_advises_only_flags_that_match_takes() {
+    let (log, _) = common::simulated_log("advice", "khepera", 60.0, 1, |c| {
+        c.faults.clock_offset = 0.3;
+    });
+    let tuples = log.with_extension("tuple");
+    let out = odocal(&[
+        "match",
+        log.to_str().unwrap(),
+        "--out",
+        tuples.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(err.contains("clock"), "no clock-offset finding: {err}");
+    // Every `--flag` the advice names outside an `odocal calibrate …` suggestion is
+    // one `match --help` lists.
+    let help = stdout(&odocal(&["match", "--help"]));
+    for line in err.lines() {
+        let own = line.split("odocal calibrate").next().unwrap_or(line);
+        for word in own.split(|c: char| c.is_whitespace() || c == '`') {
+            if let Some(flag) = word.strip_prefix("--") {
+                let flag: String = flag
+                    .chars()
+                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '-')
+                    .collect();
+                assert!(
+                    help.contains(&format!("--{flag}")),
+                    "match advises --{flag}, which it does not take: {line}"
+                );
+            }
+        }
+    }
+    common::cleanup(&log);
+}
