@@ -100,3 +100,32 @@ fn match_advises_only_flags_that_match_takes() {
     }
     common::cleanup(&log);
 }
+
+#[test]
+fn info_on_a_bag_speaks_bag_shows_health_and_collapses_identical_geometries() {
+    // turtlebot_tf: the laser writes its own, jittering, time_increment in every
+    // message; one /joint_states message is recorded twice.
+    let out = odocal(&["info", &root("fixtures/bags/turtlebot_tf.bag")]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let geometry: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("scan geometry"))
+        .collect();
+    assert_eq!(geometry.len(), 1, "{text}");
+    assert!(geometry[0].contains("59 scans"), "{text}");
+    assert!(text.contains("data health"), "no health findings: {text}");
+    assert!(text.contains("duplicate"), "{text}");
+    for encoder_word in [
+        "lines:",
+        "ticks/rev",
+        "skipped lines",
+        "comments:",
+        "/scan59",
+    ] {
+        assert!(!text.contains(encoder_word), "{encoder_word:?} in {text}");
+    }
+    // f32 fields printed with f32 precision.
+    assert!(!text.contains("0.11999999"), "{text}");
+    assert!(text.contains("0.12"), "{text}");
+}

@@ -8,7 +8,7 @@
 use crate::read_args::ReadArgs;
 use anyhow::Context;
 use odocal_bag::inspect_bag;
-use odocal_log::LogSummary;
+use odocal_log::{sensor_value, LogSummary};
 use odocal_pipeline::{health, Options};
 
 /// Arguments of `odocal info`.
@@ -48,12 +48,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         println!("{text}");
     } else {
         print!("{summary}");
-        if !findings.is_empty() {
-            println!("data health (what calibrate and match do about it):");
-        }
-        for f in &findings {
-            println!("  {f}");
-        }
+        print_findings(&findings);
     }
     Ok(())
 }
@@ -62,9 +57,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 fn bag_info(args: &Args) -> anyhow::Result<()> {
     let info = inspect_bag(&args.read.log, &args.read.bag_options()?)
         .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let (choice, summary) = match &info.calibration {
-        Ok((sel, log)) => (Ok(sel), Some(LogSummary::of(log))),
-        Err(e) => (Err(e.to_string()), None),
+    let (choice, summary, findings) = match &info.calibration {
+        Ok((sel, log)) => (
+            Ok(sel),
+            Some(LogSummary::of(log)),
+            health::check_log(log, &Options::default()).1,
+        ),
+        Err(e) => (Err(e.to_string()), None, Vec::new()),
     };
     if args.json {
         let mut obj = match &summary {
@@ -99,6 +98,7 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
                 Err(e) => o.insert("calibration_error".into(), e.clone().into()),
             };
             o.insert("warnings_bag".into(), serde_json::json!(info.warnings));
+            o.insert("health".into(), serde_json::to_value(&findings)?);
         }
         println!("{}", serde_json::to_string_pretty(&obj)?);
         return Ok(());
@@ -130,10 +130,10 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
             f.angle_min,
             f.angle_max,
             f.angle_increment,
-            f.range_min,
-            f.range_max,
-            f.time_increment,
-            f.scan_time
+            sensor_value(f.range_min),
+            sensor_value(f.range_max),
+            sensor_value(f.time_increment),
+            sensor_value(f.scan_time)
         );
     }
     for (t, names) in &info.joints {
@@ -152,7 +152,55 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
         Err(e) => println!("calibrate cannot choose: {e}"),
     }
     if let Some(s) = summary {
-        print!("{s}");
+        print_bag_summary(&s);
     }
+    print_findings(&findings);
     Ok(())
+}
+
+/// The data-health findings, under a heading when there are any.
+fn print_findings(findings: &[odocal_pipeline::Finding]) {
+    if !findings.is_empty() {
+        println!("data health (what calibrate and match do about it):");
+    }
+    for f in findings {
+        println!("  {f}");
+    }
+}
+
+/// What calibrate would read from a bag, in a bag's terms (messages and stamps; a bag
+/// has no lines, comments or encoder ticks).
+fn print_bag_summary(s: &LogSummary) {
+    let wheels = if s.encoder_records > 0 {
+        format!("{} wheel joint-state messages", s.encoder_records)
+    } else {
+        format!("{} odometry messages", s.odom_records)
+    };
+    println!("calibrate reads:  {} scans, {wheels}", s.scans);
+    match (s.start_time, s.end_time) {
+        (Some(a), Some(b)) => println!(
+            "stamps:           {a:.3} … {b:.3} s ({:.3} s)",
+            s.duration_s
+        ),
+        _ => println!("stamps:           none"),
+    }
+    for g in &s.geometries {
+        println!("scan geometry:    {g}");
+    }
+    let hz = |r: Option<f64>| r.map_or("n/a".to_string(), |r| format!("{r:.2} Hz"));
+    println!("scan rate:        {}", hz(s.scan_rate_hz));
+    if s.encoder_records > 0 {
+        println!("joint-state rate: {}", hz(s.encoder_rate_hz));
+    }
+    println!(
+        "invalid ranges:   {} ({:.2}%)",
+        s.invalid_readings,
+        100.0 * s.invalid_fraction
+    );
+    for (stream, n) in &s.out_of_order {
+        println!("out of order:     {n} {stream} messages by stamp (sorted)");
+    }
+    for w in &s.warnings {
+        println!("warning:          {w}");
+    }
 }
