@@ -129,3 +129,39 @@ fn info_on_a_bag_speaks_bag_shows_health_and_collapses_identical_geometries() {
     assert!(!text.contains("0.11999999"), "{text}");
     assert!(text.contains("0.12"), "{text}");
 }
+
+#[test]
+fn a_refusal_under_json_is_a_json_object_with_the_message_kind_and_command() {
+    let bag = root("fixtures/bags/khepera_ros1_bz2_odom.bag");
+    let out = odocal(&["calibrate", &bag, "--json"]);
+    assert!(!out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("stdout is not JSON ({e}): {:?}", stdout(&out)));
+    let message = v["error"].as_str().unwrap();
+    assert!(message.contains("--nominal"), "{v}");
+    assert!(v["kind"].is_string(), "{v}");
+    let command = v["suggested_command"].as_str().unwrap();
+    assert!(
+        command.contains(&bag) && command.contains("--nominal"),
+        "{v}"
+    );
+    // A parameter the data do not determine: the refusal names --accept-weak.
+    let short = root("fixtures/bags/turtlebot_tf.bag");
+    let out = odocal(&["calibrate", &short, "--json"]);
+    assert!(!out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(
+        v["suggested_command"]
+            .as_str()
+            .is_some_and(|c| c.ends_with("--accept-weak")),
+        "{v}"
+    );
+    // info on a file that is not there.
+    let out = odocal(&["info", "/nonexistent/odocal.log", "--json"]);
+    assert!(!out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["error"]
+        .as_str()
+        .unwrap()
+        .contains("/nonexistent/odocal.log"));
+}

@@ -11,6 +11,7 @@ use std::process::ExitCode;
 mod calibrate;
 mod info;
 mod input;
+mod json_error;
 mod matching;
 mod nominal;
 mod partial_args;
@@ -44,6 +45,18 @@ enum Command {
     TableI(table_i::Args),
 }
 
+impl Command {
+    /// True when the command was asked for JSON output (`--json`).
+    fn wants_json(&self) -> bool {
+        match self {
+            Command::Calibrate(a) => a.json,
+            Command::Solve(a) => a.json,
+            Command::Info(a) => a.json,
+            _ => false,
+        }
+    }
+}
+
 /// Lets a closed pipe end the process quietly, as it does `cat` or `grep`
 /// (`odocal info run.log | head`): Rust ignores SIGPIPE, so without this every
 /// `println!` after the reader has gone would panic with "Broken pipe".
@@ -59,6 +72,7 @@ fn exit_quietly_on_closed_pipe() {
 fn main() -> ExitCode {
     exit_quietly_on_closed_pipe();
     let cli = Cli::parse();
+    let json = cli.command.wants_json();
     let result = match cli.command {
         Command::Calibrate(a) => calibrate::run(a),
         Command::Match(a) => matching::run(a),
@@ -71,6 +85,10 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
+            if json {
+                let args: Vec<String> = std::env::args().collect();
+                println!("{}", json_error::error_object(&e, &args));
+            }
             ExitCode::FAILURE
         }
     }
