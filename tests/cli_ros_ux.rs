@@ -165,3 +165,68 @@ fn a_refusal_under_json_is_a_json_object_with_the_message_kind_and_command() {
         .unwrap()
         .contains("/nonexistent/odocal.log"));
 }
+
+/// The value of `key:` in a YAML text of `key: value` lines.
+fn yaml_value(text: &str, key: &str) -> f64 {
+    let line = text
+        .lines()
+        .find(|l| l.trim_start().starts_with(&format!("{key}:")))
+        .unwrap_or_else(|| panic!("no {key} in {text}"));
+    line.split(':').nth(1).unwrap().trim().parse().unwrap()
+}
+
+#[test]
+fn calibrate_out_and_export_write_the_results_in_ros_terms() {
+    let dir = common::temp_dir("ros-terms");
+    let out_dir = dir.join("out");
+    let out = odocal(&[
+        "calibrate",
+        &root("fixtures/bags/khepera_ros1_lz4.bag"),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let results: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out_dir.join("results.json")).unwrap()).unwrap();
+    let p = |k: &str| results[k].as_f64().unwrap();
+    let yaml = std::fs::read_to_string(out_dir.join("diff_drive_controller.yaml")).unwrap();
+    let radius = yaml_value(&yaml, "wheel_radius");
+    let left = radius * yaml_value(&yaml, "left_wheel_radius_multiplier");
+    let right = radius * yaml_value(&yaml, "right_wheel_radius_multiplier");
+    let b =
+        yaml_value(&yaml, "wheel_separation") * yaml_value(&yaml, "wheel_separation_multiplier");
+    assert!(
+        (left - p("r_l")).abs() < 1e-15 && (right - p("r_r")).abs() < 1e-15,
+        "{yaml}"
+    );
+    assert_eq!(b, p("b"), "{yaml}");
+    let urdf = std::fs::read_to_string(out_dir.join("laser_joint.urdf.xml")).unwrap();
+    let origin = format!(
+        "<origin xyz=\"{:?} {:?} 0\" rpy=\"0 0 {:?}\"/>",
+        p("l_x"),
+        p("l_y"),
+        p("l_theta")
+    );
+    assert!(urdf.contains(&origin), "{urdf} lacks {origin}");
+
+    // `odocal export` gives the same from results.json.
+    let results_path = out_dir.join("results.json");
+    let results_path = results_path.to_str().unwrap();
+    let printed = odocal(&["export", results_path, "--format", "urdf"]);
+    assert!(printed.status.success(), "{}", stderr(&printed));
+    assert_eq!(stdout(&printed), urdf);
+    let again = dir.join("again");
+    let written = odocal(&["export", results_path, "--out", again.to_str().unwrap()]);
+    assert!(written.status.success(), "{}", stderr(&written));
+    assert_eq!(
+        std::fs::read_to_string(again.join("diff_drive_controller.yaml")).unwrap(),
+        yaml
+    );
+    // Not a results.json: refused, naming the file and what was expected.
+    let bogus = dir.join("bogus.json");
+    std::fs::write(&bogus, "{\"r_l\": 0.02}").unwrap();
+    let refused = odocal(&["export", bogus.to_str().unwrap()]);
+    assert!(!refused.status.success());
+    assert!(stderr(&refused).contains("bogus.json") && stderr(&refused).contains("l_theta"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

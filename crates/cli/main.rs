@@ -9,6 +9,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod calibrate;
+mod export;
 mod info;
 mod input;
 mod json_error;
@@ -41,6 +42,8 @@ enum Command {
     Info(info::Args),
     /// Simulate a robot with encoders and a URG-04LX; write a log and its ground truth.
     Simulate(Box<simulate::Args>),
+    /// A calibration's results in ROS terms: diff_drive_controller YAML, URDF origin.
+    Export(export::Args),
     /// Reproduce the ICRA 2008 Table I in simulation and compare with the published rows.
     TableI(table_i::Args),
 }
@@ -80,6 +83,7 @@ fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Simulate(a) => simulate::run(*a),
         Command::TableI(a) => table_i::run(a),
+        Command::Export(a) => export::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,7 +1,8 @@
 //! The report of a calibration: the human summary and `results.json` ([`report`]),
 //! where the run came from
 //! ([`provenance`]), the figures ([`figures`], drawn with `plotters`), the one-page
-//! `results.html` ([`html`]) and the files `--out DIR` writes ([`output`]).
+//! `results.html` ([`html`]), the results in ROS terms ([`export`]) and the files
+//! `--out DIR` writes ([`output`]).
 //!
 //! ```no_run
 //! use odocal_pipeline::{calibrate_log, NoProgress, Options};
@@ -16,12 +17,14 @@
 
 #![deny(missing_docs)]
 
+pub mod export;
 pub mod figures;
 pub mod html;
 pub mod output;
 pub mod provenance;
 pub mod report;
 
+pub use export::{diff_drive_controller_yaml, laser_joint_urdf, write_ros_files};
 pub use odocal_pipeline::{Finding, FindingKind, Severity};
 pub use output::{html_report, write_html, write_outputs};
 pub use provenance::{sha256_of_input, Provenance};

@@ -1,5 +1,6 @@
-//! Files written by `--out DIR` (results.json, samples.tuple, results.html and, with
-//! `--plots`, one SVG per figure) and by `--report FILE.html`.
+//! Files written by `--out DIR` (results.json, samples.tuple, results.html, the
+//! results in ROS terms — diff_drive_controller.yaml and laser_joint.urdf.xml — and,
+//! with `--plots`, one SVG per figure) and by `--report FILE.html`.
 
 use crate::figures::{figures, Figure};
 use crate::html::page;
@@ -34,7 +35,8 @@ pub fn write_html(
     write_bytes_atomically(path, html_report(opts, outcome, report)?.as_bytes())
 }
 
-/// Writes `results.json`, `samples.tuple`, `results.html` and, with `plots`, the
+/// Writes `results.json`, `samples.tuple`, `results.html`, the ROS files of
+/// [`write_ros_files`](crate::export::write_ros_files) and, with `plots`, the
 /// figures as `NAME.svg` into `dir` (created if needed); each file atomically (a
 /// temporary file renamed).
 pub fn write_outputs(
@@ -55,5 +57,7 @@ pub fn write_outputs(
             write_bytes_atomically(&dir.join(format!("{}.svg", f.name)), f.svg.as_bytes())?;
         }
     }
-    Ok(())
+    // Last: parameters that cannot be a robot's (a negative radius) are refused here,
+    // after everything else was written.
+    crate::export::write_ros_files(dir, &report.params)
 }
