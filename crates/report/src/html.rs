@@ -240,6 +240,35 @@ fn figure(f: &Figure) -> Markup {
     }
 }
 
+/// The results in ROS terms, ready to paste: the diff_drive_controller parameters and
+/// the laser joint's URDF origin (the files `--out DIR` and `odocal export` write).
+fn ros_terms(r: &Report) -> Markup {
+    let files = [
+        (
+            crate::export::DIFF_DRIVE_FILE,
+            crate::export::diff_drive_controller_yaml(&r.params),
+        ),
+        (
+            crate::export::URDF_FILE,
+            crate::export::laser_joint_urdf(&r.params),
+        ),
+    ];
+    html! {
+        section #ros {
+            h2 { "In ROS terms" }
+            p { "Ready to paste (the same as the files " code { "--out DIR" } " writes and "
+                code { "odocal export results.json" } " prints). ℓ is relative to the wheel-axle midpoint; see docs/frames.md when base_link is elsewhere." }
+            @for (name, body) in &files {
+                h3 { code { (name) } }
+                @match body {
+                    Ok(text) => pre { code { (text) } },
+                    Err(e) => p.warning { (e.to_string()) },
+                }
+            }
+        }
+    }
+}
+
 /// The page of `report` with `figures`.
 pub fn page(report: &Report, figures: &[Figure]) -> String {
     page_with_results(
@@ -283,6 +312,7 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
                     (parameters(r, v))
                     p.note { "σ from the covariance of the estimate; verdicts from σ relative to the value (radii, b), to b (ℓx, ℓy), or in degrees (ℓθ)." }
                 }
+                (ros_terms(r))
                 section #j-matrix {
                     h2 { "J matrix" }
                     p { "J = [[r_L/2, r_R/2], [−r_L/b, r_R/b]] maps wheel rotations (rad) to forward travel (m) and turn (rad)." }

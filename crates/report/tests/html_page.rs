@@ -6,7 +6,7 @@
 use odocal_log::{read_log, ReadOptions};
 use odocal_pipeline::{calibrate_log, NoProgress, Options, Outcome};
 use odocal_report::figures::figures;
-use odocal_report::html::page_with_results;
+use odocal_report::html::{page, page_with_results};
 use odocal_report::{build_report, Finding, FindingKind, Provenance, Report};
 use scraper::{Html, Selector};
 use serde_json::{json, Value};
@@ -37,8 +37,9 @@ fn sel(s: &str) -> Selector {
 }
 
 /// The sections every page has.
-const SECTIONS: [&str; 7] = [
+const SECTIONS: [&str; 8] = [
     "parameters",
+    "ros",
     "j-matrix",
     "health",
     "consistency",
@@ -221,4 +222,18 @@ fn page_without_optional_results_still_has_every_section() {
     // Every run compares the two halves of its log: that check is always listed.
     assert!(text.contains("No data-health findings") && text.contains("two halves of the log"));
     numbers_agree(&doc, &serde_json::to_value(&report).unwrap());
+}
+
+#[test]
+fn page_shows_the_results_in_ros_terms_ready_to_paste() {
+    let (opts, outcome, report) = calibrated();
+    let figs = figures(&opts, &outcome, &report).expect("the figures draw");
+    let doc = Html::parse_document(&page(&report, &figs));
+    let blocks: Vec<String> = doc
+        .select(&sel("section#ros pre"))
+        .map(|e| e.text().collect())
+        .collect();
+    let yaml = odocal_report::diff_drive_controller_yaml(&report.params).unwrap();
+    let urdf = odocal_report::laser_joint_urdf(&report.params).unwrap();
+    assert_eq!(blocks, vec![yaml, urdf]);
 }
