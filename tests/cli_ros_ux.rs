@@ -230,3 +230,48 @@ fn calibrate_out_and_export_write_the_results_in_ros_terms() {
     assert!(stderr(&refused).contains("bogus.json") && stderr(&refused).contains("l_theta"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn the_nominal_laser_pose_comes_from_the_bags_static_transforms() {
+    // turtlebot_tf.bag: /tf_static base_footprint -> base_link -> base_scan, the laser
+    // at (-0.032, 0.004) m, 0.01 rad (make_bags.py: the truth rounded).
+    let bag = root("fixtures/bags/turtlebot_tf.bag");
+    let out = odocal(&["info", &bag, "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let l = &v["nominal_laser"];
+    assert_eq!(l["base_frame"], "base_link", "{v}");
+    assert_eq!(l["laser_frame"], "base_scan");
+    let close = |a: &serde_json::Value, b: f64| (a.as_f64().unwrap() - b).abs() < 1e-9;
+    assert!(
+        close(&l["x"], -0.032) && close(&l["y"], 0.004) && close(&l["theta"], 0.01),
+        "{l}"
+    );
+    // --nominal with the wheels only takes the laser pose from the bag; results.json
+    // records both.
+    let out = odocal(&[
+        "calibrate",
+        &bag,
+        "--nominal",
+        "0.033,0.033,0.16",
+        "--accept-weak",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let nominal: Vec<f64> = serde_json::from_value(v["nominal"].clone()).unwrap();
+    assert_eq!(nominal, vec![0.033, 0.033, 0.16, -0.032, 0.004, 0.01]);
+    assert_eq!(v["nominal_laser"]["base_frame"], "base_link");
+    // Six values override the bag's pose.
+    let out = odocal(&[
+        "calibrate",
+        &bag,
+        "--nominal",
+        "0.033,0.033,0.16,0,0,0",
+        "--accept-weak",
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let nominal: Vec<f64> = serde_json::from_value(v["nominal"].clone()).unwrap();
+    assert_eq!(nominal, vec![0.033, 0.033, 0.16, 0.0, 0.0, 0.0]);
+}

@@ -6,7 +6,9 @@ use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
 use anyhow::Context;
 use odocal_pipeline::{calibrate_log, Options, Trim};
-use odocal_report::{build_report, sha256_of_input, write_html, write_outputs, Provenance};
+use odocal_report::{
+    build_report, sha256_of_input, write_html, write_outputs, NominalLaserPose, Provenance,
+};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -101,10 +103,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let input = &args.input;
     let pool = input.thread_pool()?;
     let t_parse = Instant::now();
-    let mut log = input.read_log()?;
+    let (mut log, laser) = input.read.read_log_and_laser()?;
     let parse_s = t_parse.elapsed().as_secs_f64();
 
-    let initial_params = input.nominal()?;
+    let initial_params = input.nominal_with_laser(laser.as_ref())?;
     let odometry_only = odometry_only_mode(&input.read.log, &mut log, initial_params.as_ref())?;
     let mut opts = Options {
         initial_params,
@@ -129,6 +131,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
     outcome.timing.parse = parse_s;
     let mut report = build_report(&input.read.log, &log, &opts, &outcome);
+    report.nominal_laser = laser.map(|l| NominalLaserPose {
+        source: "/tf_static".into(),
+        base_frame: l.base_frame,
+        laser_frame: l.laser_frame,
+        l_x: l.x,
+        l_y: l.y,
+        l_theta: l.theta,
+    });
     let (input_sha256, input_bytes) = sha256_of_input(&input.read.log)
         .with_context(|| format!("cannot read {} for its checksum", input.read.log.display()))?;
     report.provenance = Some(Provenance {

@@ -99,6 +99,9 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
             };
             o.insert("warnings_bag".into(), serde_json::json!(info.warnings));
             o.insert("health".into(), serde_json::to_value(&findings)?);
+            if let Some(l) = &info.nominal_laser {
+                o.insert("nominal_laser".into(), serde_json::to_value(l)?);
+            }
         }
         println!("{}", serde_json::to_string_pretty(&obj)?);
         return Ok(());
@@ -138,6 +141,25 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
     }
     for (t, names) in &info.joints {
         println!("joints of {t}: {}", names.join(", "));
+    }
+    if let Some(l) = &info.nominal_laser {
+        println!(
+            "nominal laser pose (static transforms {} -> {}): l_x = {:.4} m, l_y = {:.4} m, \
+             l_theta = {:.4} rad ({:.2}°), height {:.3} m",
+            l.base_frame,
+            l.laser_frame,
+            l.x,
+            l.y,
+            l.theta,
+            l.theta.to_degrees(),
+            l.z
+        );
+        if l.tilt > 1f64.to_radians() {
+            println!(
+                "note: the laser is tilted {:.1}° from level; the planar calibration assumes it level",
+                l.tilt.to_degrees()
+            );
+        }
     }
     for w in &info.warnings {
         println!("note: {w}");

@@ -4,7 +4,7 @@
 use crate::nominal::nominal_params;
 use crate::read_args::ReadArgs;
 use anyhow::Context;
-use odocal_log::Log;
+use odocal_bag::NominalLaser;
 use odocal_solver::Params;
 
 /// The input log and the options of reading, pairing and matching it.
@@ -48,9 +48,25 @@ impl InputArgs {
         self.nominal.as_deref().map(nominal_params).transpose()
     }
 
-    /// Reads the log with the reading options of [`ReadArgs`].
-    pub fn read_log(&self) -> anyhow::Result<Log> {
-        self.read.read_log()
+    /// The parameters given with `--nominal`; when they are the wheels only (three
+    /// values), the laser pose is the bag's static transforms' `laser`, if any.
+    /// Six values override the bag's pose.
+    pub fn nominal_with_laser(
+        &self,
+        laser: Option<&NominalLaser>,
+    ) -> anyhow::Result<Option<Params>> {
+        let mut params = self.nominal()?;
+        if let (Some(p), Some(l), Some(3)) =
+            (&mut params, laser, self.nominal.as_ref().map(Vec::len))
+        {
+            *p = Params::from_vector([p.r_l, p.r_r, p.b, l.x, l.y, l.theta]);
+            eprintln!(
+                "nominal laser pose from the bag's static transforms ({} -> {}): \
+                 l_x = {:.4} m, l_y = {:.4} m, l_theta = {:.4} rad",
+                l.base_frame, l.laser_frame, l.x, l.y, l.theta
+            );
+        }
+        Ok(params)
     }
 }
 

@@ -22,8 +22,8 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<()> {
     let input = &args.input;
     let pool = input.thread_pool()?;
-    let mut log = input.read_log()?;
-    let initial_params = input.nominal()?;
+    let (mut log, laser) = input.read.read_log_and_laser()?;
+    let initial_params = input.nominal_with_laser(laser.as_ref())?;
     if let Some(n) = odometry_only_mode(&input.read.log, &mut log, initial_params.as_ref())? {
         eprintln!("{}", describe(&n));
     }

@@ -4,7 +4,7 @@
 //! `.bag`, ROS 2 directory, `.mcap`, `.db3`), told apart by content.
 
 use anyhow::Context;
-use odocal_bag::{detect_bag, read_bag, BagOptions, Clock, TopicChoice};
+use odocal_bag::{detect_bag, read_bag, BagOptions, Clock, NominalLaser, TopicChoice};
 use odocal_log::{read_log, Log, Mode, ReadOptions};
 use std::path::PathBuf;
 
@@ -111,6 +111,12 @@ impl ReadArgs {
     /// Reads the log or bag, strict unless `--lenient`, with the command-line overrides.
     /// For a bag, what was chosen and why goes to stderr.
     pub fn read_log(&self) -> anyhow::Result<Log> {
+        Ok(self.read_log_and_laser()?.0)
+    }
+
+    /// [`ReadArgs::read_log`], with the nominal laser pose of a bag's static
+    /// transforms when it has them.
+    pub fn read_log_and_laser(&self) -> anyhow::Result<(Log, Option<NominalLaser>)> {
         if self.is_bag()? {
             if self.ticks_per_rev.is_some() || self.encoder_modulus.is_some() {
                 anyhow::bail!(
@@ -124,7 +130,7 @@ impl ReadArgs {
             for r in &bag.selection.reasons {
                 eprintln!("{r}");
             }
-            return Ok(bag.log);
+            return Ok((bag.log, bag.nominal_laser));
         }
         let bag_flags = self.scan_topic.is_some()
             || self.joint_states_topic.is_some()
@@ -139,7 +145,8 @@ impl ReadArgs {
             );
         }
         // The reader's message already says everything (file, line, cause).
-        read_log(&self.log, &self.read_options()).map_err(|e| anyhow::anyhow!("{e}"))
+        let log = read_log(&self.log, &self.read_options()).map_err(|e| anyhow::anyhow!("{e}"))?;
+        Ok((log, None))
     }
 }
 

@@ -28,4 +28,4 @@ pub use export::{diff_drive_controller_yaml, laser_joint_urdf, write_ros_files};
 pub use odocal_pipeline::{Finding, FindingKind, Severity};
 pub use output::{html_report, write_html, write_outputs};
 pub use provenance::{sha256_of_input, Provenance};
-pub use report::{build_report, Report};
+pub use report::{build_report, NominalLaserPose, Report};
