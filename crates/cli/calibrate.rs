@@ -131,6 +131,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut outcome = pool.install(|| calibrate_log(&log, &opts, &bar))?;
     outcome.timing.parse = parse_s;
     let mut report = build_report(&input.read.log, &log, &opts, &outcome);
+    report.odometry_only = odometry_only.is_some();
     report.nominal_laser = laser.map(|l| NominalLaserPose {
         source: "/tf_static".into(),
         base_frame: l.base_frame,

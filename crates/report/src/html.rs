@@ -16,7 +16,7 @@ use serde_json::Value;
 const CSS: &str = include_str!("report.css");
 
 /// Top-level results.json keys shown in a section of their own.
-const SHOWN: [&str; 14] = [
+const SHOWN: [&str; 16] = [
     "log",
     "r_l",
     "r_r",
@@ -27,6 +27,8 @@ const SHOWN: [&str; 14] = [
     "sigma",
     "j",
     "nominal",
+    "nominal_laser",
+    "odometry_only",
     "correction_factors",
     "health",
     "checks",
@@ -205,6 +207,34 @@ fn parameters(r: &Report, v: &Value) -> Markup {
                     }
                     @if has_constraints { td.given { (given(v, i, scale, digits)) } }
                 }
+            }
+            @if let Some(offset) = r.time_offset_s {
+                tr #clock-offset {
+                    th { "clock offset (laser − encoders)" }
+                    td { (num("/time_offset_s", offset, 1e3, 2)) }
+                    td { @match v.get("time_offset_sigma_s").and_then(Value::as_f64) {
+                        Some(sd) => { "± " (num("/time_offset_sigma_s", sd, 1e3, 2)) },
+                        None => "—",
+                    } }
+                    td { "ms" }
+                    td { "estimated" }
+                    @if r.nominal.is_some() { td { "—" } td { "—" } }
+                    @if has_constraints { td.given { "—" } }
+                }
+            }
+        }
+        @if r.odometry_only {
+            p.warning #odometry-only {
+                "Odometry-only mode: the input has odometry poses, no wheel encoders; the wheel rotations were recovered from the poses with the nominal r_L, r_R and b (--nominal). The absolute radii and wheel distance are only as good as those nominal values; the correction factors (estimate / nominal) are what the data determine."
+            }
+        }
+        @if let Some(l) = &r.nominal_laser {
+            p.note #nominal-laser {
+                "The bag's " (l.source) " puts the laser frame " code { (l.laser_frame) } " in " code { (l.base_frame) } " at "
+                (num("/nominal_laser/l_x", l.l_x, 1e3, 1)) " mm, " (num("/nominal_laser/l_y", l.l_y, 1e3, 1)) " mm, "
+                (num("/nominal_laser/l_theta", l.l_theta, 180.0 / std::f64::consts::PI, 2)) "°; the calibrated pose differs by "
+                (format!("{:.1} mm, {:.1} mm, {:.2}°", (values[3] - l.l_x) * 1e3, (values[4] - l.l_y) * 1e3, (values[5] - l.l_theta).to_degrees()))
+                " (ℓ is relative to the wheel-axle midpoint, which is " code { (l.base_frame) } " only if the robot's description puts it there: docs/frames.md)."
             }
         }
     }

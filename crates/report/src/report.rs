@@ -67,6 +67,10 @@ pub struct Report {
     /// The nominal parameters given (`--nominal`), order r_L, r_R, b, ℓx, ℓy, ℓθ.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub nominal: Option<[f64; 6]>,
+    /// Odometry-only mode: the wheel rotations were recovered from odometry poses with
+    /// the nominal parameters (whose absolute scale the radii then inherit).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub odometry_only: bool,
     /// The laser pose the input's own description gives (a bag's `/tf_static`), in
     /// the base frame named there.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -200,6 +204,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
         nominal: opts.initial_params.map(|p| p.to_vector()),
         nominal_laser: None,
+        odometry_only: false,
         correction_factors: opts
             .initial_params
             .map(|n| [v[0] / n.r_l, v[1] / n.r_r, v[2] / n.b]),

@@ -237,3 +237,54 @@ fn page_shows_the_results_in_ros_terms_ready_to_paste() {
     let urdf = odocal_report::laser_joint_urdf(&report.params).unwrap();
     assert_eq!(blocks, vec![yaml, urdf]);
 }
+
+#[test]
+fn parameters_table_has_the_clock_offset_and_the_page_says_odometry_only_and_the_tf_pose() {
+    let (opts, outcome, mut report) = calibrated();
+    report.time_offset_s = None;
+    let figs = figures(&opts, &outcome, &report).expect("the figures draw");
+    let plain = Html::parse_document(&page(&report, &figs));
+    for id in ["clock-offset", "odometry-only", "nominal-laser"] {
+        assert!(
+            plain.select(&sel(&format!("#{id}"))).next().is_none(),
+            "{id}"
+        );
+    }
+    report.time_offset_s = Some(0.1234);
+    report.odometry_only = true;
+    report.nominal_laser = Some(odocal_report::NominalLaserPose {
+        source: "/tf_static".into(),
+        base_frame: "base_link".into(),
+        laser_frame: "base_scan".into(),
+        l_x: 0.01,
+        l_y: 0.0,
+        l_theta: 0.0,
+    });
+    let results = serde_json::to_value(&report).unwrap();
+    let doc = Html::parse_document(&page_with_results(&report, &results, &figs));
+    let row: String = doc
+        .select(&sel("table.params tr#clock-offset"))
+        .next()
+        .expect("a clock-offset row")
+        .text()
+        .collect();
+    assert!(
+        row.contains("123.40") && row.contains("ms") && row.contains("—"),
+        "{row}"
+    );
+    let odo: String = doc
+        .select(&sel("#odometry-only"))
+        .next()
+        .unwrap()
+        .text()
+        .collect();
+    assert!(odo.contains("--nominal"), "{odo}");
+    let tf: String = doc
+        .select(&sel("#nominal-laser"))
+        .next()
+        .unwrap()
+        .text()
+        .collect();
+    assert!(tf.contains("base_scan") && tf.contains("10.0 mm"), "{tf}");
+    assert!(numbers_agree(&doc, &results).contains(&"/time_offset_s".to_string()));
+}
