@@ -320,7 +320,21 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
         .flatten()
         .filter(|(k, _)| !SHOWN.contains(&k.as_str()) && !DATA_KEYS.contains(&k.as_str()))
         .collect();
-    let advice = coverage_advice(&r.observability.motion.missing());
+    let missing = r.observability.motion.missing();
+    let halves_short = matches!(
+        r.consistency,
+        odocal_pipeline::consistency::Consistency::NotAvailable { .. }
+    );
+    // The whole log may have every motion while each half alone lacks some: then the
+    // coverage sentence must not say all is well next to the two-halves note.
+    let advice = if missing.is_empty() && halves_short {
+        "The log as a whole has spins in place, straight runs and arcs, but its halves \
+         could not be checked against each other (see the two-halves note under \
+         Consistency checks): drive each kind of motion several times, spread over the run."
+            .to_string()
+    } else {
+        coverage_advice(&missing)
+    };
     html! {
         (DOCTYPE)
         html lang="en" {

@@ -288,3 +288,28 @@ fn parameters_table_has_the_clock_offset_and_the_page_says_odometry_only_and_the
     assert!(tf.contains("base_scan") && tf.contains("10.0 mm"), "{tf}");
     assert!(numbers_agree(&doc, &results).contains(&"/time_offset_s".to_string()));
 }
+
+#[test]
+fn coverage_advice_does_not_contradict_the_two_halves_note() {
+    let (opts, outcome, mut report) = calibrated();
+    assert!(
+        report.observability.motion.missing().is_empty(),
+        "the demo log was expected to have every kind of motion"
+    );
+    report.consistency = odocal_pipeline::consistency::Consistency::NotAvailable {
+        reason: "the second half has no straight runs".into(),
+    };
+    let figs = figures(&opts, &outcome, &report).expect("the figures draw");
+    let doc = Html::parse_document(&page(&report, &figs));
+    let advice: String = doc
+        .select(&sel("p.advice"))
+        .next()
+        .unwrap()
+        .text()
+        .collect();
+    assert!(
+        !advice.contains("every parameter has the motion it needs"),
+        "{advice}"
+    );
+    assert!(advice.contains("halves"), "{advice}");
+}
