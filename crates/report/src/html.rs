@@ -88,6 +88,51 @@ fn significant(x: f64) -> String {
     }
 }
 
+/// The parameters with their units, as column and row headings.
+const PARAMETER_UNITS: [&str; 6] = [
+    "r_L (m)",
+    "r_R (m)",
+    "b (m)",
+    "ℓx (m)",
+    "ℓy (m)",
+    "ℓθ (rad)",
+];
+
+/// A value of the "Data and solution" section: vectors and matrices over the six
+/// parameters (or the three scan-matching components) as tables labelled with names
+/// and units; anything else as [`json`].
+fn labelled(key: &str, v: &Value) -> Markup {
+    let pointer = format!("/{key}");
+    let headings: &[&str] = match key {
+        "covariance" | "closed_form" => &PARAMETER_UNITS,
+        "sm_sigma" => &["x (m)", "y (m)", "θ (rad)"],
+        _ => return json(v, &pointer),
+    };
+    let Some(rows) = v.as_array().filter(|a| a.len() == headings.len()) else {
+        return json(v, &pointer);
+    };
+    html! {
+        table.matrix {
+            tr { @if key == "covariance" { th { } } @for h in headings { th { (h) } } }
+            @if key == "covariance" {
+                @for (i, row) in rows.iter().enumerate() {
+                    tr {
+                        th { (headings[i]) }
+                        @for (k, x) in row.as_array().into_iter().flatten().enumerate() {
+                            td { (json(x, &format!("{pointer}/{i}/{k}"))) }
+                        }
+                    }
+                }
+            } @else {
+                tr { @for (i, x) in rows.iter().enumerate() { td { (json(x, &format!("{pointer}/{i}"))) } } }
+            }
+        }
+        @if key == "covariance" {
+            p.note { "Units: the product of the row's and the column's units (m², m·rad, rad²)." }
+        }
+    }
+}
+
 /// A JSON value (numbers to [`SIGNIFICANT`] digits): scalars as text, arrays of numbers inline, arrays of arrays
 /// as a matrix, arrays of objects as a table, objects as a key–value table.
 fn json(v: &Value, pointer: &str) -> Markup {
@@ -381,7 +426,7 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
                 section #data {
                     h2 { "Data and solution" }
                     table.kv { @for k in DATA_KEYS { @if let Some(x) = v.get(k) {
-                        tr { th { (words(k)) } td { (json(x, &format!("/{k}"))) } }
+                        tr { th { (words(k)) } td { (labelled(k, x)) } }
                     } } }
                 }
                 @if !further.is_empty() {

@@ -313,3 +313,19 @@ fn coverage_advice_does_not_contradict_the_two_halves_note() {
     );
     assert!(advice.contains("halves"), "{advice}");
 }
+
+#[test]
+fn the_covariance_is_a_table_labelled_with_parameters_and_units() {
+    let (opts, outcome, report) = calibrated();
+    let figs = figures(&opts, &outcome, &report).expect("the figures draw");
+    let doc = Html::parse_document(&page(&report, &figs));
+    let headings: Vec<String> = doc
+        .select(&sel("section#data table.matrix th"))
+        .map(|e| e.text().collect())
+        .collect();
+    assert!(
+        headings.iter().filter(|h| h.as_str() == "ℓθ (rad)").count() >= 2,
+        "{headings:?}"
+    );
+    assert!(headings.iter().any(|h| h == "θ (rad)"), "{headings:?}");
+}
