@@ -11,7 +11,8 @@ use anyhow::Context;
 use odocal_log::Log;
 use odocal_pipeline::{calibrate_log, calibrate_logs, Options, Trim};
 use odocal_report::{
-    build_joint_report, build_report, sha256_of_input, write_html, write_outputs, Provenance,
+    build_joint_report, build_report, sha256_of_input, write_html, write_outputs, NominalLaserPose,
+    Provenance,
 };
 use std::path::PathBuf;
 use std::time::Instant;
@@ -129,11 +130,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let t_parse = Instant::now();
     let paths = input.paths();
-    let (mut logs, mut checksums): (Vec<Log>, Vec<Option<(String, u64)>>) =
-        input.read_logs()?.into_iter().unzip();
+    let inputs = input.read_logs()?;
     let parse_s = t_parse.elapsed().as_secs_f64();
+    // The laser's nominal pose from the first bag with static transforms.
+    let laser = inputs.iter().find_map(|r| r.nominal_laser.clone());
+    let (mut logs, mut checksums): (Vec<Log>, Vec<Option<(String, u64)>>) =
+        inputs.into_iter().map(|r| (r.log, r.checksum)).unzip();
 
-    let initial_params = input.nominal()?;
+    let initial_params = input.nominal_with_laser(laser.as_ref())?;
     let mut odometry_only = None;
     for (path, log) in paths.iter().zip(logs.iter_mut()) {
         let mode = odometry_only_mode(path, log, initial_params.as_ref())?;
@@ -188,6 +192,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     outcome.timing.parse = parse_s;
     report.timing_s.parse = parse_s;
+    report.odometry_only = odometry_only.is_some();
+    report.nominal_laser = laser.map(|l| NominalLaserPose {
+        source: "/tf_static".into(),
+        base_frame: l.base_frame,
+        laser_frame: l.laser_frame,
+        l_x: l.x,
+        l_y: l.y,
+        l_theta: l.theta,
+    });
     let (input_sha256, input_bytes) = match checksums[0].take() {
         Some(c) => c,
         None => sha256_of_input(paths[0])

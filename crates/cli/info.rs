@@ -9,7 +9,7 @@ use crate::read_args::ReadArgs;
 use crate::terminal::{out, outln, write_json_stdout};
 use anyhow::Context;
 use odocal_bag::inspect_bag;
-use odocal_log::LogSummary;
+use odocal_log::{sensor_value, LogSummary};
 use odocal_pipeline::{health, Options};
 
 /// Arguments of `odocal info`.
@@ -49,23 +49,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         write_json_stdout(&text)?;
     } else {
         out!("{summary}")?;
-        if !findings.is_empty() {
-            outln!("data health (what calibrate and match do about it):")?;
-        }
-        for f in &findings {
-            outln!("  {f}")?;
-        }
+        print_findings(&findings)?;
     }
     Ok(())
 }
 
 /// `odocal info BAG`.
 fn bag_info(args: &Args) -> anyhow::Result<()> {
-    let info = inspect_bag(&args.read.log, &args.read.bag_options())
+    let info = inspect_bag(&args.read.log, &args.read.bag_options()?)
         .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let (choice, summary) = match &info.calibration {
-        Ok((sel, log)) => (Ok(sel), Some(LogSummary::of(log))),
-        Err(e) => (Err(e.to_string()), None),
+    let (choice, summary, findings) = match &info.calibration {
+        Ok((sel, log)) => (
+            Ok(sel),
+            Some(LogSummary::of(log)),
+            health::check_log(log, &Options::default()).1,
+        ),
+        Err(e) => (Err(e.to_string()), None, Vec::new()),
     };
     if args.json {
         let mut obj = match &summary {
@@ -100,6 +99,10 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
                 Err(e) => o.insert("calibration_error".into(), e.clone().into()),
             };
             o.insert("warnings_bag".into(), serde_json::json!(info.warnings));
+            o.insert("health".into(), serde_json::to_value(&findings)?);
+            if let Some(l) = &info.nominal_laser {
+                o.insert("nominal_laser".into(), serde_json::to_value(l)?);
+            }
         }
         write_json_stdout(&serde_json::to_string_pretty(&obj)?)?;
         return Ok(());
@@ -131,14 +134,33 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
             f.angle_min,
             f.angle_max,
             f.angle_increment,
-            f.range_min,
-            f.range_max,
-            f.time_increment,
-            f.scan_time
+            sensor_value(f.range_min),
+            sensor_value(f.range_max),
+            sensor_value(f.time_increment),
+            sensor_value(f.scan_time)
         )?;
     }
     for (t, names) in &info.joints {
         outln!("joints of {t}: {}", names.join(", "))?;
+    }
+    if let Some(l) = &info.nominal_laser {
+        outln!(
+            "nominal laser pose (static transforms {} -> {}): l_x = {:.4} m, l_y = {:.4} m, \
+             l_theta = {:.4} rad ({:.2}°), height {:.3} m",
+            l.base_frame,
+            l.laser_frame,
+            l.x,
+            l.y,
+            l.theta,
+            l.theta.to_degrees(),
+            l.z
+        )?;
+        if l.tilt > 1f64.to_radians() {
+            outln!(
+                "note: the laser is tilted {:.1}° from level; the planar calibration assumes it level",
+                l.tilt.to_degrees()
+            )?;
+        }
     }
     for w in &info.warnings {
         outln!("note: {w}")?;
@@ -153,7 +175,57 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
         Err(e) => outln!("calibrate cannot choose: {e}")?,
     }
     if let Some(s) = summary {
-        out!("{s}")?;
+        print_bag_summary(&s)?;
+    }
+    print_findings(&findings)?;
+    Ok(())
+}
+
+/// The data-health findings, under a heading when there are any.
+fn print_findings(findings: &[odocal_pipeline::Finding]) -> anyhow::Result<()> {
+    if !findings.is_empty() {
+        outln!("data health (what calibrate and match do about it):")?;
+    }
+    for f in findings {
+        outln!("  {f}")?;
+    }
+    Ok(())
+}
+
+/// What calibrate would read from a bag, in a bag's terms (messages and stamps; a bag
+/// has no lines, comments or encoder ticks).
+fn print_bag_summary(s: &LogSummary) -> anyhow::Result<()> {
+    let wheels = if s.encoder_records > 0 {
+        format!("{} wheel joint-state messages", s.encoder_records)
+    } else {
+        format!("{} odometry messages", s.odom_records)
+    };
+    outln!("calibrate reads:  {} scans, {wheels}", s.scans)?;
+    match (s.start_time, s.end_time) {
+        (Some(a), Some(b)) => outln!(
+            "stamps:           {a:.3} … {b:.3} s ({:.3} s)",
+            s.duration_s
+        ),
+        _ => outln!("stamps:           none"),
+    }?;
+    for g in &s.geometries {
+        outln!("scan geometry:    {g}")?;
+    }
+    let hz = |r: Option<f64>| r.map_or("n/a".to_string(), |r| format!("{r:.2} Hz"));
+    outln!("scan rate:        {}", hz(s.scan_rate_hz))?;
+    if s.encoder_records > 0 {
+        outln!("joint-state rate: {}", hz(s.encoder_rate_hz))?;
+    }
+    outln!(
+        "invalid ranges:   {} ({:.2}%)",
+        s.invalid_readings,
+        100.0 * s.invalid_fraction
+    )?;
+    for (stream, n) in &s.out_of_order {
+        outln!("out of order:     {n} {stream} messages by stamp (sorted)")?;
+    }
+    for w in &s.warnings {
+        outln!("warning:          {w}")?;
     }
     Ok(())
 }

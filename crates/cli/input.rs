@@ -2,10 +2,10 @@
 //! robot's nominal parameters, how to pair its scans, and how many threads match them.
 
 use crate::nominal::nominal_params;
-use crate::read_args::ReadArgs;
+use crate::read_args::{ReadArgs, ReadInput};
 use crate::terminal::errln;
 use anyhow::Context;
-use odocal_log::Log;
+use odocal_bag::NominalLaser;
 use odocal_solver::Params;
 use std::path::{Path, PathBuf};
 
@@ -62,10 +62,9 @@ impl InputArgs {
             .collect()
     }
 
-    /// Reads every log given, each with the reading options of [`ReadArgs`], with the
-    /// SHA-256 and size of each text log computed on the same single pass (`None` for a
-    /// bag; see [`ReadArgs::read_log_and_checksum`]).
-    pub fn read_logs(&self) -> anyhow::Result<Vec<(Log, Option<(String, u64)>)>> {
+    /// Reads every log given, each with the reading options of [`ReadArgs`], with what
+    /// the single read of each tells besides the log (see [`ReadArgs::read_input`]).
+    pub fn read_logs(&self) -> anyhow::Result<Vec<ReadInput>> {
         self.paths()
             .into_iter()
             .map(|path| {
@@ -73,9 +72,34 @@ impl InputArgs {
                     log: path.to_path_buf(),
                     ..self.read.clone()
                 }
-                .read_log_and_checksum()
+                .read_input()
             })
             .collect()
+    }
+
+    /// The parameters given with `--nominal`; when they are the wheels only (three
+    /// values), the laser pose is the bag's static transforms' `laser`, if any.
+    /// Six values override the bag's pose.
+    pub fn nominal_with_laser(
+        &self,
+        laser: Option<&NominalLaser>,
+    ) -> anyhow::Result<Option<Params>> {
+        let mut params = self.nominal()?;
+        if let (Some(p), Some(l), Some(3)) =
+            (&mut params, laser, self.nominal.as_ref().map(Vec::len))
+        {
+            *p = Params::from_vector([p.r_l, p.r_r, p.b, l.x, l.y, l.theta]);
+            errln!(
+                "nominal laser pose from the bag's static transforms ({} -> {}): \
+                 l_x = {:.4} m, l_y = {:.4} m, l_theta = {:.4} rad",
+                l.base_frame,
+                l.laser_frame,
+                l.x,
+                l.y,
+                l.theta
+            );
+        }
+        Ok(params)
     }
 }
 

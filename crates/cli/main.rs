@@ -10,8 +10,10 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 mod calibrate;
+mod export;
 mod info;
 mod input;
+mod json_error;
 mod matching;
 mod nominal;
 mod open_input;
@@ -44,8 +46,22 @@ enum Command {
     Info(info::Args),
     /// Simulate a robot with encoders and a URG-04LX; write a log and its ground truth.
     Simulate(Box<simulate::Args>),
+    /// A calibration's results in ROS terms: diff_drive_controller YAML, URDF origin.
+    Export(export::Args),
     /// Reproduce the ICRA 2008 Table I in simulation and compare with the published rows.
     TableI(table_i::Args),
+}
+
+impl Command {
+    /// True when the command was asked for JSON output (`--json`).
+    fn wants_json(&self) -> bool {
+        match self {
+            Command::Calibrate(a) => a.json,
+            Command::Solve(a) => a.json,
+            Command::Info(a) => a.json,
+            _ => false,
+        }
+    }
 }
 
 /// Lets a closed pipe end the process quietly, as it does `cat` or `grep`
@@ -63,6 +79,7 @@ fn exit_quietly_on_closed_pipe() {
 fn main() -> ExitCode {
     exit_quietly_on_closed_pipe();
     let cli = Cli::parse();
+    let json = cli.command.wants_json();
     let result = match cli.command {
         Command::Calibrate(a) => calibrate::run(a),
         Command::Match(a) => matching::run(a),
@@ -70,11 +87,16 @@ fn main() -> ExitCode {
         Command::Info(a) => info::run(a),
         Command::Simulate(a) => simulate::run(*a),
         Command::TableI(a) => table_i::run(a),
+        Command::Export(a) => export::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             errln!("error: {e:#}");
+            if json {
+                let args: Vec<String> = std::env::args().collect();
+                let _ = terminal::write_json_stdout(&json_error::error_object(&e, &args).to_string());
+            }
             ExitCode::FAILURE
         }
     }

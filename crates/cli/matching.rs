@@ -30,8 +30,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         check_file_output(&args.out, log_path)
             .with_context(|| format!("cannot write {}", args.out.display()))?;
     }
-    let mut logs: Vec<_> = input.read_logs()?.into_iter().map(|(log, _)| log).collect();
-    let initial_params = input.nominal()?;
+    let inputs = input.read_logs()?;
+    // The laser's nominal pose from the first bag with static transforms.
+    let laser = inputs.iter().find_map(|r| r.nominal_laser.clone());
+    let initial_params = input.nominal_with_laser(laser.as_ref())?;
+    let mut logs: Vec<_> = inputs.into_iter().map(|r| r.log).collect();
     for (path, log) in paths.iter().zip(logs.iter_mut()) {
         if let Some(n) = odometry_only_mode(path, log, initial_params.as_ref())? {
             errln!("{}: {}", path.display(), describe(&n));

@@ -5,7 +5,7 @@
 
 use crate::open_input::{is_bag_file, read_text_log};
 use crate::terminal::errln;
-use odocal_bag::{read_bag, BagOptions, Clock, TopicChoice};
+use odocal_bag::{read_bag, BagOptions, Clock, NominalLaser, TopicChoice};
 use odocal_log::{Log, Mode, ReadOptions};
 use std::path::PathBuf;
 
@@ -13,8 +13,9 @@ use std::path::PathBuf;
 #[derive(clap::Args, Debug, Clone)]
 pub struct ReadArgs {
     /// The log: Carmen-style text, the original package's JSON log, or a ROS bag (ROS 1
-    /// .bag, ROS 2 bag directory, .mcap or .db3). A text log may be a pipe or FIFO, or
-    /// `-` for standard input; a bag must be a file or directory.
+    /// .bag, ROS 2 bag directory or its metadata.yaml, .mcap or .db3). A text log may be
+    /// a pipe or FIFO, or `-` for standard input; a bag must be a file or directory.
+    #[arg(value_parser = log_path)]
     pub log: PathBuf,
     /// Bag: the sensor_msgs/LaserScan topic (default: the only one).
     #[arg(long, value_name = "TOPIC")]
@@ -26,8 +27,8 @@ pub struct ReadArgs {
     #[arg(long, value_name = "TOPIC")]
     pub odom_topic: Option<String>,
     /// Bag: the left and right wheel joint names (default: the only joints named like a
-    /// left and a right wheel).
-    #[arg(long, value_name = "LEFT,RIGHT", value_delimiter = ',', num_args = 2)]
+    /// left and a right wheel). `LEFT,RIGHT` or `LEFT RIGHT`.
+    #[arg(long, value_name = "LEFT,RIGHT", value_delimiter = ',', num_args = 1..=2)]
     pub wheel_joints: Option<Vec<String>>,
     /// Bag: stamp messages with the bag's record time instead of their header stamp.
     #[arg(long)]
@@ -66,18 +67,15 @@ impl ReadArgs {
         }
     }
 
-    /// The bag reading options these arguments ask for.
-    pub fn bag_options(&self) -> BagOptions {
-        BagOptions {
+    /// The bag reading options these arguments ask for; an error when `--wheel-joints`
+    /// does not name exactly two joints.
+    pub fn bag_options(&self) -> anyhow::Result<BagOptions> {
+        Ok(BagOptions {
             choice: TopicChoice {
                 scan_topic: self.scan_topic.clone(),
                 joint_states_topic: self.joint_states_topic.clone(),
                 odom_topic: self.odom_topic.clone(),
-                wheel_joints: self
-                    .wheel_joints
-                    .as_ref()
-                    .filter(|v| v.len() == 2)
-                    .map(|v| (v[0].clone(), v[1].clone())),
+                wheel_joints: self.wheel_joints()?,
             },
             clock: if self.use_receive_time {
                 Clock::Receive
@@ -85,6 +83,23 @@ impl ReadArgs {
                 Clock::Header
             },
             read: self.read_options(),
+        })
+    }
+
+    /// The two joints of `--wheel-joints` (left, right), or an error naming what was given.
+    fn wheel_joints(&self) -> anyhow::Result<Option<(String, String)>> {
+        match self.wheel_joints.as_deref() {
+            None => Ok(None),
+            Some([left, right]) if !left.is_empty() && !right.is_empty() => {
+                Ok(Some((left.clone(), right.clone())))
+            }
+            Some(given) => anyhow::bail!(
+                "--wheel-joints takes two joint names, the left and the right wheel's: \
+                 `--wheel-joints LEFT,RIGHT` (e.g. --wheel-joints \
+                 wheel_left_joint,wheel_right_joint); got {} value(s): {:?}",
+                given.len(),
+                given
+            ),
         }
     }
 
@@ -96,12 +111,13 @@ impl ReadArgs {
     /// Reads the log or bag, strict unless `--lenient`, with the command-line overrides.
     /// For a bag, what was chosen and why goes to stderr.
     pub fn read_log(&self) -> anyhow::Result<Log> {
-        Ok(self.read_log_and_checksum()?.0)
+        Ok(self.read_input()?.log)
     }
 
-    /// [`ReadArgs::read_log`], with the SHA-256 and size of a text log, computed on the
-    /// same single pass (`None` for a bag: see `sha256_of_input`).
-    pub fn read_log_and_checksum(&self) -> anyhow::Result<(Log, Option<(String, u64)>)> {
+    /// [`ReadArgs::read_log`], with what the same single read tells besides the log:
+    /// the SHA-256 and size of a text log, the nominal laser pose of a bag's static
+    /// transforms.
+    pub fn read_input(&self) -> anyhow::Result<ReadInput> {
         if self.is_bag()? {
             if self.ticks_per_rev.is_some() || self.encoder_modulus.is_some() {
                 anyhow::bail!(
@@ -111,7 +127,7 @@ impl ReadArgs {
                 );
             }
             let bag =
-                read_bag(&self.log, &self.bag_options()).map_err(|e| anyhow::anyhow!("{e}"))?;
+                read_bag(&self.log, &self.bag_options()?).map_err(|e| anyhow::anyhow!("{e}"))?;
             for r in &bag.selection.reasons {
                 errln!("{r}");
             }
@@ -119,7 +135,11 @@ impl ReadArgs {
             for w in &bag.log.stats.warnings {
                 errln!("warning: {w}");
             }
-            return Ok((bag.log, None));
+            return Ok(ReadInput {
+                log: bag.log,
+                checksum: None,
+                nominal_laser: bag.nominal_laser,
+            });
         }
         let bag_flags = self.scan_topic.is_some()
             || self.joint_states_topic.is_some()
@@ -134,6 +154,36 @@ impl ReadArgs {
             );
         }
         let (log, checksum) = read_text_log(&self.log, &self.read_options())?;
-        Ok((log, Some(checksum)))
+        Ok(ReadInput {
+            log,
+            checksum: Some(checksum),
+            nominal_laser: None,
+        })
+    }
+}
+
+/// What [`ReadArgs::read_input`] read.
+pub struct ReadInput {
+    /// The log (a bag's messages in the log model).
+    pub log: Log,
+    /// SHA-256 (hex) and size of a text log, computed on the one pass that read it
+    /// (`None` for a bag: see `sha256_of_input`).
+    pub checksum: Option<(String, u64)>,
+    /// The laser's pose from a bag's static transforms, when it has them.
+    pub nominal_laser: Option<NominalLaser>,
+}
+
+/// The input path as given, except that a ROS 2 bag's `metadata.yaml` stands for its
+/// bag directory (the bag is the directory, not the YAML file).
+fn log_path(arg: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(arg);
+    let is_metadata = path.file_name().is_some_and(|n| n == "metadata.yaml");
+    match path.parent() {
+        Some(dir) if is_metadata && path.is_file() => Ok(if dir.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            dir.to_path_buf()
+        }),
+        _ => Ok(path),
     }
 }

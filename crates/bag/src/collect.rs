@@ -5,8 +5,10 @@
 use crate::error::{seconds, BagError};
 use crate::limits::MAX_DECODED_BYTES;
 use crate::messages::{
-    decode_joint_state, decode_laser_scan, decode_odometry, MessageKind, OdometryMsg, ScanFields,
+    decode_joint_state, decode_laser_scan, decode_odometry, header_frame, MessageKind, OdometryMsg,
+    ScanFields,
 };
+use crate::tf::{decode_tf_message, TfTree};
 use crate::wire::Encoding;
 use crate::zstd_input::decompress_message;
 use std::collections::HashMap;
@@ -60,6 +62,8 @@ pub(crate) struct ScanRecord {
 /// The decoded scans of one topic, and the messages that could not be decoded.
 #[derive(Debug, Default)]
 pub(crate) struct ScanTopic {
+    /// The first message's `header.frame_id`.
+    pub(crate) frame_id: Option<String>,
     pub(crate) records: Vec<ScanRecord>,
     pub(crate) ranges: Vec<f32>,
     pub(crate) undecodable: Skipped,
@@ -155,6 +159,8 @@ pub struct Collected {
     pub(crate) scans: HashMap<usize, ScanTopic>,
     pub(crate) joints: HashMap<usize, JointTopic>,
     pub(crate) odom: HashMap<usize, Vec<(OdometryMsg, u64)>>,
+    /// The static transforms of `/tf_static` and `/tf`.
+    pub tf: TfTree,
     filter: DecodeFilter,
     /// Files read, in order.
     pub files: Vec<String>,
@@ -211,11 +217,13 @@ impl Collected {
             MessageKind::LaserScan => &self.filter.scan_topic,
             MessageKind::JointState => &self.filter.joint_states_topic,
             MessageKind::Odometry => &self.filter.odom_topic,
-            MessageKind::Other => &None,
+            MessageKind::Transforms | MessageKind::Other => &None,
         };
         let skipped = kind == MessageKind::JointState && self.filter.odometry_only;
-        let decode =
-            kind != MessageKind::Other && !skipped && wanted.as_deref().is_none_or(|w| w == name);
+        let decode = kind == MessageKind::Transforms
+            || (kind != MessageKind::Other
+                && !skipped
+                && wanted.as_deref().is_none_or(|w| w == name));
         self.topics.push(TopicStats {
             name: name.to_string(),
             type_name: type_name.to_string(),
@@ -296,6 +304,9 @@ impl Collected {
         let kept = match kind {
             MessageKind::LaserScan => {
                 let topic = self.scans.entry(i).or_default();
+                if topic.frame_id.is_none() {
+                    topic.frame_id = Some(header_frame(body, encoding).map_err(fail)?);
+                }
                 let offset = topic.ranges.len();
                 match decode_laser_scan(body, encoding, &mut topic.ranges) {
                     Ok((fields, len)) => {
@@ -352,6 +363,14 @@ impl Collected {
                 let msg = decode_odometry(body, encoding).map_err(fail)?;
                 self.odom.entry(i).or_default().push((msg, receive_ns));
                 std::mem::size_of::<(OdometryMsg, u64)>()
+            }
+            MessageKind::Transforms => {
+                let transforms = decode_tf_message(body, encoding).map_err(fail)?;
+                let n = transforms.len();
+                for t in transforms {
+                    self.tf.add(t);
+                }
+                n * 128
             }
             MessageKind::Other => 0,
         };

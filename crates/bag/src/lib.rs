@@ -27,6 +27,7 @@ mod ros1;
 mod scan_check;
 mod select;
 mod sqlite_source;
+pub mod tf;
 mod to_log;
 mod wire;
 mod zstd_input;
@@ -36,6 +37,7 @@ pub use detect::{bag_format_of_head, detect_bag, BagFormat};
 pub use error::BagError;
 pub use messages::{normalize_type, MessageKind, ScanFields};
 pub use select::{Selection, TopicChoice, WheelSource};
+pub use tf::NominalLaser;
 pub use to_log::Clock;
 pub use wire::{Encoding, WireError};
 
@@ -63,6 +65,9 @@ pub struct BagLog {
     pub log: Log,
     /// What was chosen and why.
     pub selection: Selection,
+    /// The laser's pose in the base frame from the bag's static transforms, when they
+    /// link the scan's frame to the base.
+    pub nominal_laser: Option<NominalLaser>,
     /// Every topic of the bag.
     pub topics: Vec<TopicStats>,
     /// Bytes of bag files read.
@@ -139,10 +144,20 @@ pub fn read_bag(path: &Path, opts: &BagOptions) -> Result<BagLog, BagError> {
     Ok(BagLog {
         format,
         log,
+        nominal_laser: nominal_laser(&collected, &selection.scan_topic),
         selection,
         topics: collected.topics.clone(),
         bytes_read: collected.bytes_read,
     })
+}
+
+/// The nominal pose of the laser of `scan_topic` from the static transforms.
+fn nominal_laser(c: &Collected, scan_topic: &str) -> Option<NominalLaser> {
+    let frame = c
+        .topic_index(scan_topic)
+        .and_then(|i| c.scans.get(&i))
+        .and_then(|s| s.frame_id.as_deref())?;
+    c.tf.nominal_laser(frame)
 }
 
 /// The laser geometry of a scan topic as its first message declares it.
@@ -188,6 +203,8 @@ pub struct BagInfo {
     pub joints: Vec<(String, Vec<String>)>,
     /// What `calibrate` would use (or why it cannot decide), and the log it would read.
     pub calibration: Result<(Selection, Log), BagError>,
+    /// The chosen laser's pose in the base frame from the static transforms.
+    pub nominal_laser: Option<NominalLaser>,
     /// Bytes of bag files read.
     pub bytes_read: u64,
     /// Notes from reading.
@@ -226,8 +243,13 @@ pub fn inspect_bag(path: &Path, opts: &BagOptions) -> Result<BagInfo, BagError> 
         let log = to_log::build_log(&name, &c, &sel, opts.clock, &opts.read)?;
         Ok((sel, log))
     });
+    let nominal_laser = calibration
+        .as_ref()
+        .ok()
+        .and_then(|(sel, _)| nominal_laser(&c, &sel.scan_topic));
     Ok(BagInfo {
         format,
+        nominal_laser,
         topics: c.topics.clone(),
         lasers,
         joints,

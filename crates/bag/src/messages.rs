@@ -1,5 +1,6 @@
-//! The three message types odocal reads, decoded from ROS 1 or CDR bodies:
-//! `sensor_msgs/LaserScan`, `sensor_msgs/JointState`, `nav_msgs/Odometry`.
+//! The message types odocal reads, decoded from ROS 1 or CDR bodies:
+//! `sensor_msgs/LaserScan`, `sensor_msgs/JointState`, `nav_msgs/Odometry` (and the
+//! transforms of `tf2_msgs/TFMessage`, in [`crate::tf`]).
 
 use crate::wire::{Encoding, Wire, WireError};
 
@@ -13,6 +14,8 @@ pub enum MessageKind {
     JointState,
     /// `nav_msgs/Odometry`.
     Odometry,
+    /// `tf2_msgs/TFMessage` (ROS 1 also `tf/tfMessage`).
+    Transforms,
     /// Anything else: counted, never decoded.
     Other,
 }
@@ -25,6 +28,7 @@ impl MessageKind {
             "sensor_msgs/LaserScan" => MessageKind::LaserScan,
             "sensor_msgs/JointState" => MessageKind::JointState,
             "nav_msgs/Odometry" => MessageKind::Odometry,
+            "tf2_msgs/TFMessage" | "tf/tfMessage" => MessageKind::Transforms,
             _ => MessageKind::Other,
         }
     }
@@ -35,6 +39,7 @@ impl MessageKind {
             MessageKind::LaserScan => "sensor_msgs/LaserScan",
             MessageKind::JointState => "sensor_msgs/JointState",
             MessageKind::Odometry => "nav_msgs/Odometry",
+            MessageKind::Transforms => "tf2_msgs/TFMessage",
             MessageKind::Other => "(other)",
         }
     }
@@ -98,6 +103,11 @@ pub(crate) fn decode_laser_scan(
         return Err(e);
     }
     Ok((fields, n))
+}
+
+/// The `header.frame_id` of a message that starts with a header (a LaserScan's frame).
+pub(crate) fn header_frame(body: &[u8], encoding: Encoding) -> Result<String, WireError> {
+    Ok(Wire::new(body, encoding)?.header()?.1.to_string())
 }
 
 /// A decoded `sensor_msgs/JointState` (effort is not kept).

@@ -148,7 +148,11 @@ impl<'a> Wire<'a> {
     /// A sequence length, checked against the bytes left (each element takes at least
     /// `min_element` bytes) and against [`MAX_SEQUENCE_LEN`], so a corrupt length cannot
     /// ask for a huge allocation.
-    fn length(&mut self, field: &'static str, min_element: usize) -> Result<usize, WireError> {
+    pub(crate) fn length(
+        &mut self,
+        field: &'static str,
+        min_element: usize,
+    ) -> Result<usize, WireError> {
         let at = self.pos;
         let n = self.u32(field)? as usize;
         let left = self.data.len() - self.pos;
@@ -248,6 +252,11 @@ impl<'a> Wire<'a> {
     /// A `std_msgs/Header`: returns its stamp in nanoseconds (ROS 1: seq, stamp,
     /// frame_id; ROS 2: stamp, frame_id).
     pub(crate) fn header_stamp_ns(&mut self) -> Result<i64, WireError> {
+        Ok(self.header()?.0)
+    }
+
+    /// A `std_msgs/Header`: its stamp in nanoseconds and its frame_id.
+    pub(crate) fn header(&mut self) -> Result<(i64, &'a str), WireError> {
         if !self.aligned {
             self.u32("header.seq")?;
         }
@@ -257,8 +266,8 @@ impl<'a> Wire<'a> {
             self.u32("header.stamp.sec")? as i64
         };
         let nsec = self.u32("header.stamp.nanosec")? as i64;
-        self.string("header.frame_id")?;
-        Ok(sec * 1_000_000_000 + nsec)
+        let frame = self.string("header.frame_id")?;
+        Ok((sec * 1_000_000_000 + nsec, frame))
     }
 }
 

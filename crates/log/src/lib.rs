@@ -37,7 +37,7 @@ pub use model::*;
 pub use options::{Mode, ReadOptions};
 pub use printable::{json_text, needs_escape, printable, terminal_text};
 pub use read::{detect_format, read_log, read_log_from, LogFormat};
-pub use summary::{GeometrySummary, LogSummary, SkippedLine};
+pub use summary::{sensor_value, GeometrySummary, LogSummary, SkippedLine};
 pub use tokens::MAX_COUNT;
 pub use tuple::{read_tuples, read_tuples_from, write_tuple, TupleRecord};
 pub use wheel_angles::{

@@ -28,6 +28,46 @@ pub struct GeometrySummary {
     pub scans: usize,
 }
 
+impl GeometrySummary {
+    /// True when `other` describes the same rays (everything but the scan count).
+    fn same_shape(&self, other: &GeometrySummary) -> bool {
+        GeometrySummary {
+            scans: other.scans,
+            ..self.clone()
+        } == *other
+    }
+}
+
+impl fmt::Display for GeometrySummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} rays from {:.6} rad every {:.8} rad (fov {:.6} rad), range ({}, {}) m, \
+             laser type {}: {} scans",
+            self.rays,
+            self.start_angle,
+            self.resolution,
+            self.fov,
+            sensor_value(self.min_range),
+            self.max_range.map_or("∞".to_string(), sensor_value),
+            self.laser_type,
+            self.scans
+        )
+    }
+}
+
+/// A value as text with the precision it was recorded with: a value that is exactly a
+/// 32-bit float (a ROS message's `float32` field) with the digits of an `f32`
+/// (0.12, not 0.11999999731779099), any other with those of an `f64`.
+pub fn sensor_value(x: f64) -> String {
+    let narrow = x as f32;
+    if f64::from(narrow) == x {
+        narrow.to_string()
+    } else {
+        x.to_string()
+    }
+}
+
 /// One skipped line (lenient mode).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SkippedLine {
@@ -124,7 +164,8 @@ impl LogSummary {
         for s in &scans.scans {
             per_geometry[s.geometry as usize] += 1;
         }
-        let geometries: Vec<GeometrySummary> = scans
+        let mut geometries: Vec<GeometrySummary> = Vec::new();
+        let described = scans
             .geometries
             .iter()
             .zip(&per_geometry)
@@ -137,8 +178,15 @@ impl LogSummary {
                 min_range: g.min_range,
                 laser_type: g.laser_type,
                 scans: n,
-            })
-            .collect();
+            });
+        // Geometries that differ only in what the summary does not show (a laser that
+        // writes its own sweep timing in every message) are one line, their scans summed.
+        for g in described {
+            match geometries.iter_mut().find(|s| s.same_shape(&g)) {
+                Some(same) => same.scans += g.scans,
+                None => geometries.push(g),
+            }
+        }
         let rays_per_scan = geometries
             .iter()
             .filter(|g| g.scans > 0)
@@ -211,7 +259,7 @@ impl fmt::Display for LogSummary {
         writeln!(f, "lines:          {}", self.lines)?;
         writeln!(f, "messages:")?;
         for (name, n) in &self.messages {
-            writeln!(f, "  {name:<14}{n}")?;
+            writeln!(f, "  {name:<13} {n}")?;
         }
         writeln!(
             f,
@@ -244,19 +292,7 @@ impl fmt::Display for LogSummary {
             _ => writeln!(f, "time span:      no timestamped records")?,
         }
         for g in &self.geometries {
-            writeln!(
-                f,
-                "scan geometry:  {} rays from {:.6} rad every {:.8} rad (fov {:.6} rad), \
-                 range ({}, {}) m, laser type {}: {} scans",
-                g.rays,
-                g.start_angle,
-                g.resolution,
-                g.fov,
-                g.min_range,
-                g.max_range.map_or("∞".to_string(), |r| r.to_string()),
-                g.laser_type,
-                g.scans
-            )?;
+            writeln!(f, "scan geometry:  {g}")?;
         }
         let hz = |r: Option<f64>| r.map_or("n/a".to_string(), |r| format!("{r:.2} Hz"));
         writeln!(f, "scan rate:      {}", hz(self.scan_rate_hz))?;

@@ -16,7 +16,7 @@ use serde_json::Value;
 const CSS: &str = include_str!("report.css");
 
 /// Top-level results.json keys shown in a section of their own.
-const SHOWN: [&str; 15] = [
+const SHOWN: [&str; 17] = [
     "log",
     "logs",
     "r_l",
@@ -28,6 +28,8 @@ const SHOWN: [&str; 15] = [
     "sigma",
     "j",
     "nominal",
+    "nominal_laser",
+    "odometry_only",
     "correction_factors",
     "health",
     "checks",
@@ -85,6 +87,51 @@ fn significant(x: f64) -> String {
         format!("{x:.decimals$}")
     } else {
         format!("{x:.*e}", SIGNIFICANT - 1)
+    }
+}
+
+/// The parameters with their units, as column and row headings.
+const PARAMETER_UNITS: [&str; 6] = [
+    "r_L (m)",
+    "r_R (m)",
+    "b (m)",
+    "ℓx (m)",
+    "ℓy (m)",
+    "ℓθ (rad)",
+];
+
+/// A value of the "Data and solution" section: vectors and matrices over the six
+/// parameters (or the three scan-matching components) as tables labelled with names
+/// and units; anything else as [`json`].
+fn labelled(key: &str, v: &Value) -> Markup {
+    let pointer = format!("/{key}");
+    let headings: &[&str] = match key {
+        "covariance" | "closed_form" => &PARAMETER_UNITS,
+        "sm_sigma" => &["x (m)", "y (m)", "θ (rad)"],
+        _ => return json(v, &pointer),
+    };
+    let Some(rows) = v.as_array().filter(|a| a.len() == headings.len()) else {
+        return json(v, &pointer);
+    };
+    html! {
+        table.matrix {
+            tr { @if key == "covariance" { th { } } @for h in headings { th { (h) } } }
+            @if key == "covariance" {
+                @for (i, row) in rows.iter().enumerate() {
+                    tr {
+                        th { (headings[i]) }
+                        @for (k, x) in row.as_array().into_iter().flatten().enumerate() {
+                            td { (json(x, &format!("{pointer}/{i}/{k}"))) }
+                        }
+                    }
+                }
+            } @else {
+                tr { @for (i, x) in rows.iter().enumerate() { td { (json(x, &format!("{pointer}/{i}"))) } } }
+            }
+        }
+        @if key == "covariance" {
+            p.note { "Units: the product of the row's and the column's units (m², m·rad, rad²)." }
+        }
     }
 }
 
@@ -208,6 +255,34 @@ fn parameters(r: &Report, v: &Value) -> Markup {
                     @if has_constraints { td.given { (given(v, i, scale, digits)) } }
                 }
             }
+            @if let Some(offset) = r.time_offset_s {
+                tr #clock-offset {
+                    th { "clock offset (laser − encoders)" }
+                    td { (num("/time_offset_s", offset, 1e3, 2)) }
+                    td { @match v.get("time_offset_sigma_s").and_then(Value::as_f64) {
+                        Some(sd) => { "± " (num("/time_offset_sigma_s", sd, 1e3, 2)) },
+                        None => "—",
+                    } }
+                    td { "ms" }
+                    td { "estimated" }
+                    @if r.nominal.is_some() { td { "—" } td { "—" } }
+                    @if has_constraints { td.given { "—" } }
+                }
+            }
+        }
+        @if r.odometry_only {
+            p.warning #odometry-only {
+                "Odometry-only mode: the input has odometry poses, no wheel encoders; the wheel rotations were recovered from the poses with the nominal r_L, r_R and b (--nominal). The absolute radii and wheel distance are only as good as those nominal values; the correction factors (estimate / nominal) are what the data determine."
+            }
+        }
+        @if let Some(l) = &r.nominal_laser {
+            p.note #nominal-laser {
+                "The bag's " (l.source) " puts the laser frame " code { (l.laser_frame) } " in " code { (l.base_frame) } " at "
+                (num("/nominal_laser/l_x", l.l_x, 1e3, 1)) " mm, " (num("/nominal_laser/l_y", l.l_y, 1e3, 1)) " mm, "
+                (num("/nominal_laser/l_theta", l.l_theta, 180.0 / std::f64::consts::PI, 2)) "°; the calibrated pose differs by "
+                (format!("{:.1} mm, {:.1} mm, {:.2}°", (values[3] - l.l_x) * 1e3, (values[4] - l.l_y) * 1e3, (values[5] - l.l_theta).to_degrees()))
+                " (ℓ is relative to the wheel-axle midpoint, which is " code { (l.base_frame) } " only if the robot's description puts it there: docs/frames.md)."
+            }
         }
     }
 }
@@ -242,6 +317,35 @@ fn figure(f: &Figure) -> Markup {
     }
 }
 
+/// The results in ROS terms, ready to paste: the diff_drive_controller parameters and
+/// the laser joint's URDF origin (the files `--out DIR` and `odocal export` write).
+fn ros_terms(r: &Report) -> Markup {
+    let files = [
+        (
+            crate::export::DIFF_DRIVE_FILE,
+            crate::export::diff_drive_controller_yaml(&r.params),
+        ),
+        (
+            crate::export::URDF_FILE,
+            crate::export::laser_joint_urdf(&r.params),
+        ),
+    ];
+    html! {
+        section #ros {
+            h2 { "In ROS terms" }
+            p { "Ready to paste (the same as the files " code { "--out DIR" } " writes and "
+                code { "odocal export results.json" } " prints). ℓ is relative to the wheel-axle midpoint; see docs/frames.md when base_link is elsewhere." }
+            @for (name, body) in &files {
+                h3 { code { (name) } }
+                @match body {
+                    Ok(text) => pre { code { (text) } },
+                    Err(e) => p.warning { (e.to_string()) },
+                }
+            }
+        }
+    }
+}
+
 /// The page of `report` with `figures`.
 pub fn page(report: &Report, figures: &[Figure]) -> String {
     page_with_results(
@@ -263,7 +367,21 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
         .flatten()
         .filter(|(k, _)| !SHOWN.contains(&k.as_str()) && !DATA_KEYS.contains(&k.as_str()))
         .collect();
-    let advice = coverage_advice(&r.observability.motion.missing());
+    let missing = r.observability.motion.missing();
+    let halves_short = matches!(
+        r.consistency,
+        odocal_pipeline::consistency::Consistency::NotAvailable { .. }
+    );
+    // The whole log may have every motion while each half alone lacks some: then the
+    // coverage sentence must not say all is well next to the two-halves note.
+    let advice = if missing.is_empty() && halves_short {
+        "The log as a whole has spins in place, straight runs and arcs, but its halves \
+         could not be checked against each other (see the two-halves note under \
+         Consistency checks): drive each kind of motion several times, spread over the run."
+            .to_string()
+    } else {
+        coverage_advice(&missing)
+    };
     html! {
         (DOCTYPE)
         html lang="en" {
@@ -292,6 +410,7 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
                         (json(logs, "/logs"))
                     }
                 }
+                (ros_terms(r))
                 section #j-matrix {
                     h2 { "J matrix" }
                     p { "J = [[r_L/2, r_R/2], [−r_L/b, r_R/b]] maps wheel rotations (rad) to forward travel (m) and turn (rad)." }
@@ -316,7 +435,7 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
                 section #data {
                     h2 { "Data and solution" }
                     table.kv { @for k in DATA_KEYS { @if let Some(x) = v.get(k) {
-                        tr { th { (words(k)) } td { (json(x, &format!("/{k}"))) } }
+                        tr { th { (words(k)) } td { (labelled(k, x)) } }
                     } } }
                 }
                 @if !further.is_empty() {

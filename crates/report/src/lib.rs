@@ -1,7 +1,8 @@
 //! The report of a calibration: the human summary and `results.json` ([`report`]),
 //! the joint report of several logs ([`joint`]), where the run came from
 //! ([`provenance`]), the figures ([`figures`], drawn with `plotters`), the one-page
-//! `results.html` ([`html`]) and the files `--out DIR` writes ([`output`]).
+//! `results.html` ([`html`]), the results in ROS terms ([`export`]) and the files
+//! `--out DIR` writes ([`output`]).
 //!
 //! ```no_run
 //! use odocal_pipeline::{calibrate_log, NoProgress, Options};
@@ -16,6 +17,7 @@
 
 #![deny(missing_docs)]
 
+pub mod export;
 pub mod figures;
 pub mod html;
 pub mod joint;
@@ -23,8 +25,9 @@ pub mod output;
 pub mod provenance;
 pub mod report;
 
+pub use export::{diff_drive_controller_yaml, laser_joint_urdf, write_ros_files};
 pub use joint::{build_joint_report, LogRow};
 pub use odocal_pipeline::{Finding, FindingKind, Severity};
 pub use output::{html_report, is_output_name, write_html, write_outputs};
 pub use provenance::{sha256_of_input, Provenance};
-pub use report::{build_report, Report};
+pub use report::{build_report, NominalLaserPose, Report};

@@ -1,6 +1,8 @@
-//! Files written by `--out DIR` (results.json, samples.tuple, results.html and, with
-//! `--plots`, one SVG per figure) and by `--report FILE.html`.
+//! Files written by `--out DIR` (results.json, samples.tuple, results.html, the
+//! results in ROS terms — diff_drive_controller.yaml and laser_joint.urdf.xml — and,
+//! with `--plots`, one SVG per figure) and by `--report FILE.html`.
 
+use crate::export::{diff_drive_controller_yaml, laser_joint_urdf, DIFF_DRIVE_FILE, URDF_FILE};
 use crate::figures::{figures, Figure};
 use crate::html::page;
 use crate::report::Report;
@@ -39,13 +41,19 @@ pub fn write_html(
 /// True for the names of the files [`write_outputs`] writes, so an old `--out`
 /// directory holding nothing else may be replaced.
 pub fn is_output_name(name: &str) -> bool {
-    matches!(name, "results.json" | "samples.tuple" | "results.html") || name.ends_with(".svg")
+    matches!(
+        name,
+        "results.json" | "samples.tuple" | "results.html" | DIFF_DRIVE_FILE | URDF_FILE
+    ) || name.ends_with(".svg")
 }
 
-/// Writes `results.json`, `samples.tuple`, `results.html` and, with `plots`, the
+/// Writes `results.json`, `samples.tuple`, `results.html`, the ROS files of
+/// [`write_ros_files`](crate::export::write_ros_files) and, with `plots`, the
 /// figures as `NAME.svg` as the directory `dir`, all files or none: they are written
 /// into a fresh directory that then replaces `dir` (see
 /// [`odocal_pipeline::atomic_dir`]); a `dir` holding other files is refused.
+/// Parameters that cannot be a robot's (a negative radius) have no ROS files: the
+/// others are written and the error says why.
 pub fn write_outputs(
     dir: &Path,
     opts: &Options,
@@ -55,6 +63,8 @@ pub fn write_outputs(
 ) -> io::Result<()> {
     let json = serde_json::to_string_pretty(report).map_err(io::Error::other)?;
     let figs = drawn(opts, outcome, report)?;
+    let ros_yaml = diff_drive_controller_yaml(&report.params);
+    let ros_urdf = laser_joint_urdf(&report.params);
     write_dir_atomically(dir, &is_output_name, |fresh| {
         write_bytes_atomically(&fresh.join("results.json"), (json + "\n").as_bytes())?;
         write_tuples(&fresh.join("samples.tuple"), &outcome.synced.samples)?;
@@ -64,6 +74,11 @@ pub fn write_outputs(
                 write_bytes_atomically(&fresh.join(format!("{}.svg", f.name)), f.svg.as_bytes())?;
             }
         }
+        if let (Ok(yaml), Ok(urdf)) = (&ros_yaml, &ros_urdf) {
+            write_bytes_atomically(&fresh.join(DIFF_DRIVE_FILE), yaml.as_bytes())?;
+            write_bytes_atomically(&fresh.join(URDF_FILE), urdf.as_bytes())?;
+        }
         Ok(())
-    })
+    })?;
+    ros_yaml.and(ros_urdf).map(|_| ()).map_err(io::Error::other)
 }

@@ -71,6 +71,14 @@ pub struct Report {
     /// The nominal parameters given (`--nominal`), order r_L, r_R, b, ℓx, ℓy, ℓθ.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub nominal: Option<[f64; 6]>,
+    /// Odometry-only mode: the wheel rotations were recovered from odometry poses with
+    /// the nominal parameters (whose absolute scale the radii then inherit).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub odometry_only: bool,
+    /// The laser pose the input's own description gives (a bag's `/tf_static`), in
+    /// the base frame named there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal_laser: Option<NominalLaserPose>,
     /// With nominal values: `estimate / nominal` of r_L, r_R and b, what to multiply
     /// the robot's configured values by.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -92,6 +100,23 @@ pub struct Report {
     /// With several logs calibrated together: one row per log.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub logs: Vec<crate::joint::LogRow>,
+}
+
+/// A nominal laser pose read from the input (a bag's static transforms).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct NominalLaserPose {
+    /// Where it was read (`/tf_static`).
+    pub source: String,
+    /// The frame it is relative to (`base_link`, `base_footprint`, …).
+    pub base_frame: String,
+    /// The scan's frame.
+    pub laser_frame: String,
+    /// Forward offset (m).
+    pub l_x: f64,
+    /// Leftward offset (m).
+    pub l_y: f64,
+    /// Yaw (rad).
+    pub l_theta: f64,
 }
 
 /// Counts from the log reader.
@@ -186,6 +211,8 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
         time_offset_sigma_s: outcome.offset.as_ref().and_then(|o| o.sigma),
         nominal: opts.initial_params.map(|p| p.to_vector()),
+        nominal_laser: None,
+        odometry_only: false,
         correction_factors: opts
             .initial_params
             .map(|n| [v[0] / n.r_l, v[1] / n.r_r, v[2] / n.b]),

@@ -6,7 +6,7 @@
 use odocal_log::{read_log, ReadOptions};
 use odocal_pipeline::{calibrate_log, NoProgress, Options, Outcome};
 use odocal_report::figures::figures;
-use odocal_report::html::page_with_results;
+use odocal_report::html::{page, page_with_results};
 use odocal_report::{build_report, Finding, FindingKind, Provenance, Report};
 use scraper::{Html, Selector};
 use serde_json::{json, Value};
@@ -37,8 +37,9 @@ fn sel(s: &str) -> Selector {
 }
 
 /// The sections every page has.
-const SECTIONS: [&str; 7] = [
+const SECTIONS: [&str; 8] = [
     "parameters",
+    "ros",
     "j-matrix",
     "health",
     "consistency",
@@ -221,4 +222,110 @@ fn page_without_optional_results_still_has_every_section() {
     // Every run compares the two halves of its log: that check is always listed.
     assert!(text.contains("No data-health findings") && text.contains("two halves of the log"));
     numbers_agree(&doc, &serde_json::to_value(&report).unwrap());
+}
+
+#[test]
+fn page_shows_the_results_in_ros_terms_ready_to_paste() {
+    let (opts, outcome, report) = calibrated();
+    let figs = figures(&opts, &outcome, &report).expect("the figures draw");
+    let doc = Html::parse_document(&page(&report, &figs));
+    let blocks: Vec<String> = doc
+        .select(&sel("section#ros pre"))
+        .map(|e| e.text().collect())
+        .collect();
+    let yaml = odocal_report::diff_drive_controller_yaml(&report.params).unwrap();
+    let urdf = odocal_report::laser_joint_urdf(&report.params).unwrap();
+    assert_eq!(blocks, vec![yaml, urdf]);
+}
+
+#[test]
+fn parameters_table_has_the_clock_offset_and_the_page_says_odometry_only_and_the_tf_pose() {
+    let (opts, outcome, mut report) = calibrated();
+    report.time_offset_s = None;
+    let figs = figures(&opts, &outcome, &report).expect("the figures draw");
+    let plain = Html::parse_document(&page(&report, &figs));
+    for id in ["clock-offset", "odometry-only", "nominal-laser"] {
+        assert!(
+            plain.select(&sel(&format!("#{id}"))).next().is_none(),
+            "{id}"
+        );
+    }
+    report.time_offset_s = Some(0.1234);
+    report.odometry_only = true;
+    report.nominal_laser = Some(odocal_report::NominalLaserPose {
+        source: "/tf_static".into(),
+        base_frame: "base_link".into(),
+        laser_frame: "base_scan".into(),
+        l_x: 0.01,
+        l_y: 0.0,
+        l_theta: 0.0,
+    });
+    let results = serde_json::to_value(&report).unwrap();
+    let doc = Html::parse_document(&page_with_results(&report, &results, &figs));
+    let row: String = doc
+        .select(&sel("table.params tr#clock-offset"))
+        .next()
+        .expect("a clock-offset row")
+        .text()
+        .collect();
+    assert!(
+        row.contains("123.40") && row.contains("ms") && row.contains("—"),
+        "{row}"
+    );
+    let odo: String = doc
+        .select(&sel("#odometry-only"))
+        .next()
+        .unwrap()
+        .text()
+        .collect();
+    assert!(odo.contains("--nominal"), "{odo}");
+    let tf: String = doc
+        .select(&sel("#nominal-laser"))
+        .next()
+        .unwrap()
+        .text()
+        .collect();
+    assert!(tf.contains("base_scan") && tf.contains("10.0 mm"), "{tf}");
+    assert!(numbers_agree(&doc, &results).contains(&"/time_offset_s".to_string()));
+}
+
+#[test]
+fn coverage_advice_does_not_contradict_the_two_halves_note() {
+    let (opts, outcome, mut report) = calibrated();
+    assert!(
+        report.observability.motion.missing().is_empty(),
+        "the demo log was expected to have every kind of motion"
+    );
+    report.consistency = odocal_pipeline::consistency::Consistency::NotAvailable {
+        reason: "the second half has no straight runs".into(),
+    };
+    let figs = figures(&opts, &outcome, &report).expect("the figures draw");
+    let doc = Html::parse_document(&page(&report, &figs));
+    let advice: String = doc
+        .select(&sel("p.advice"))
+        .next()
+        .unwrap()
+        .text()
+        .collect();
+    assert!(
+        !advice.contains("every parameter has the motion it needs"),
+        "{advice}"
+    );
+    assert!(advice.contains("halves"), "{advice}");
+}
+
+#[test]
+fn the_covariance_is_a_table_labelled_with_parameters_and_units() {
+    let (opts, outcome, report) = calibrated();
+    let figs = figures(&opts, &outcome, &report).expect("the figures draw");
+    let doc = Html::parse_document(&page(&report, &figs));
+    let headings: Vec<String> = doc
+        .select(&sel("section#data table.matrix th"))
+        .map(|e| e.text().collect())
+        .collect();
+    assert!(
+        headings.iter().filter(|h| h.as_str() == "ℓθ (rad)").count() >= 2,
+        "{headings:?}"
+    );
+    assert!(headings.iter().any(|h| h == "θ (rad)"), "{headings:?}");
 }

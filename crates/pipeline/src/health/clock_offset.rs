@@ -151,8 +151,9 @@ pub fn found_offset_finding(q: &QuickOffset, used: f64, estimated: bool) -> Find
         )
     } else {
         format!(
-            "the results are biased unless the offset is applied: pass \
-             `--estimate-time-offset --time-offset-range {range}` or `--time-offset {:.2}`",
+            "the results are biased unless the offset is applied: pass `--time-offset {:.2}`, \
+             or have it estimated with `odocal calibrate … --estimate-time-offset \
+             --time-offset-range {range}`",
             q.offset
         )
     };

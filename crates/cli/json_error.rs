@@ -1,0 +1,53 @@
+//! A refusal under `--json`: one JSON object on stdout, so that a script reading the
+//! output gets the reason instead of nothing. `{"error": the message, "kind": what
+//! refused, "suggested_command": the same command with the flag the message asks
+//! for}` (the last only when the message asks for one); the exit code stays non-zero.
+
+use odocal_log::LogError;
+use odocal_pipeline::PipelineError;
+use serde_json::{json, Value};
+
+/// The JSON object describing `error` for the command line `args`.
+pub fn error_object(error: &anyhow::Error, args: &[String]) -> Value {
+    let pipeline = error
+        .chain()
+        .find_map(|e| e.downcast_ref::<PipelineError>());
+    let kind = match pipeline {
+        Some(PipelineError::Log(_)) => "log",
+        Some(PipelineError::TooFewSamples { .. }) => "too_few_samples",
+        Some(PipelineError::Solve(_)) => "solve",
+        Some(PipelineError::NotDetermined { .. }) => "not_determined",
+        Some(PipelineError::DataFault { .. }) => "data_fault",
+        Some(PipelineError::InvalidSetting(_)) => "invalid_setting",
+        Some(PipelineError::Implausible(_)) => "implausible",
+        None if error.chain().any(|e| e.is::<LogError>()) => "log",
+        None if error.chain().any(|e| e.is::<std::io::Error>()) => "io",
+        None => "refused",
+    };
+    let message = format!("{error:#}");
+    let mut object = json!({ "error": message, "kind": kind });
+    if let Some(flag) = suggested_flag(pipeline, &message) {
+        let mut command: Vec<&str> = args.iter().map(String::as_str).collect();
+        command.push(flag);
+        object["suggested_command"] = command.join(" ").into();
+    }
+    object
+}
+
+/// The flag a refusal asks the user to add, when it asks for one.
+fn suggested_flag(error: Option<&PipelineError>, message: &str) -> Option<&'static str> {
+    let not_determined = match error {
+        Some(PipelineError::NotDetermined { .. }) => true,
+        Some(PipelineError::DataFault { refusal, .. }) => {
+            matches!(**refusal, PipelineError::NotDetermined { .. })
+        }
+        _ => false,
+    };
+    if not_determined {
+        Some("--accept-weak")
+    } else if message.contains("--nominal r_L,r_R,b") {
+        Some("--nominal r_L,r_R,b")
+    } else {
+        None
+    }
+}
