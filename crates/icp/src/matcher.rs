@@ -506,7 +506,7 @@ impl Matcher {
                 || unc.condition_number > params.max_condition_number,
             weakest_direction: unc.weakest_direction,
             residual_spread: robust_spread(&mut self.squared_residuals),
-            noise_sigma: scans_noise(reference, current),
+            noise_sigma: scans_noise(reference, current, params),
             matched_share: (used as f64 / current.lined_count.max(1) as f64).min(1.0),
             starts: 1,
         };

@@ -21,9 +21,42 @@ pub struct MatchStats {
     pub mean_residual: f64,
 }
 
+/// Scans sampled to estimate the log's typical range noise.
+const NOISE_SAMPLE_SCANS: usize = 64;
+
+/// The median range noise (σ, m) of up to [`NOISE_SAMPLE_SCANS`] scans spread evenly
+/// over the store, among those whose noise shows (straight stretches); 0 when none
+/// does. What the matcher's consistency test assumes for scans too cluttered or
+/// sparse to show their own.
+pub fn typical_noise_sigma(scans: &ScanStore, params: &IcpParams) -> f64 {
+    let every = (scans.len() / NOISE_SAMPLE_SCANS).max(1);
+    let mut noise: Vec<f64> = (0..scans.len())
+        .step_by(every)
+        .filter_map(|i| {
+            let s = scans.get(i)?;
+            PreparedScan::new(
+                s.ranges,
+                &s.geometry.angles,
+                s.geometry.min_range,
+                s.geometry.max_range,
+                params,
+            )
+            .ok()?
+            .noise_sigma()
+        })
+        .collect();
+    if noise.is_empty() {
+        return 0.0;
+    }
+    let mid = noise.len() / 2;
+    *noise.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
 /// Matches the pairs `(first, second)` of scan indices, each with its first guess,
 /// in parallel (rayon's current pool). Results come back in pair order and do not
 /// depend on the number of threads. `done` is called once per pair (progress).
+/// Without a [`IcpParams::typical_noise_sigma`], the store's own
+/// ([`typical_noise_sigma`]) is used.
 pub fn match_pairs(
     scans: &ScanStore,
     pairs: &[(usize, usize)],
@@ -32,6 +65,13 @@ pub fn match_pairs(
     done: impl Fn() + Sync + Send,
 ) -> Vec<Result<MatchStats, String>> {
     debug_assert_eq!(pairs.len(), first_guesses.len());
+    let mut own_params;
+    let mut params = params;
+    if params.typical_noise_sigma == 0.0 {
+        own_params = params.clone();
+        own_params.typical_noise_sigma = typical_noise_sigma(scans, params);
+        params = &own_params;
+    }
     let prepare = |i: usize| match scans.get(i) {
         Some(s) => PreparedScan::new(
             s.ranges,
