@@ -62,3 +62,45 @@ fn scans_without_straight_stretches_take_the_typical_noise() {
         r.pose
     );
 }
+
+#[test]
+fn points_where_the_reference_had_no_return_do_not_count_against_the_overlap() {
+    // A wall 1.5 m ahead and a side wall: the reference scan got no return on 40 % of
+    // its rays (dark or glass surface, as 55 % of the real URG-04LX's readings), the
+    // current scan, 2 cm further, got them all.
+    let angles: Vec<f64> = (0..341)
+        .map(|i| (-60.0 + i as f64 * 120.0 / 340.0).to_radians())
+        .collect();
+    let scan_at = |x: f64, seed: u64, dark: bool| -> Vec<f32> {
+        let mut normal = Normal(seed);
+        angles
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                if dark && (80..220).contains(&i) {
+                    return 0.0;
+                }
+                // Front wall at 1.5 − x, side wall at y = 1.0.
+                let front = (1.5 - x) / a.cos();
+                let side = if a.sin() > 0.0 {
+                    1.0 / a.sin()
+                } else {
+                    f64::INFINITY
+                };
+                (front.min(side) + 0.002 * normal.sample()) as f32
+            })
+            .collect()
+    };
+    let params = IcpParams::default();
+    let reference = PreparedScan::new(&scan_at(0.0, 3, true), &angles, 0.02, 5.6, &params).unwrap();
+    let current = PreparedScan::new(&scan_at(0.02, 4, false), &angles, 0.02, 5.6, &params).unwrap();
+    let r = Matcher::new(params)
+        .match_scans(&reference, &current, Pose2::IDENTITY)
+        .unwrap();
+    assert!(r.matched_share > 0.85, "matched share {}", r.matched_share);
+    assert!(
+        (r.pose.x - 0.02).abs() < 0.003 && r.pose.y.abs() < 0.003,
+        "{}",
+        r.pose
+    );
+}

@@ -104,7 +104,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         match r {
             Ok(_) => ok += 1,
             Err(e) => {
-                let key: String = e.split(':').next().unwrap_or("").chars().take(40).collect();
+                let key = e.reason.key().to_string();
                 *tally.entry(key).or_default() += 1;
             }
         }

@@ -1,6 +1,7 @@
 //! The scan-matching stage: ŝ for every synchronized pair, in parallel.
 
 use crate::parallel::match_chain;
+use crate::rejection::{MatchFailure, Rejection};
 use odocal_geom::Pose2;
 use odocal_icp::{IcpParams, Matcher, PreparedScan};
 use odocal_log::ScanStore;
@@ -63,7 +64,7 @@ pub fn match_pairs(
     first_guesses: &[Pose2],
     params: &IcpParams,
     done: impl Fn() + Sync + Send,
-) -> Vec<Result<MatchStats, String>> {
+) -> Vec<Result<MatchStats, MatchFailure>> {
     debug_assert_eq!(pairs.len(), first_guesses.len());
     let mut own_params;
     let mut params = params;
@@ -80,8 +81,16 @@ pub fn match_pairs(
             s.geometry.max_range,
             params,
         )
-        .map_err(|e| format!("scan {i} (line {}): {e}", s.line)),
-        None => Err(format!("scan {i} does not exist")),
+        .map_err(|e| {
+            MatchFailure::new(
+                Rejection::of(&e),
+                format!("scan {i} (line {}): {e}", s.line),
+            )
+        }),
+        None => Err(MatchFailure::new(
+            Rejection::Scan,
+            format!("scan {i} does not exist"),
+        )),
     };
     match_chain(
         pairs,
@@ -94,9 +103,12 @@ pub fn match_pairs(
             };
             let r = matcher
                 .match_scans(reference, current, first_guesses[k])
-                .map_err(|e| e.to_string())?;
+                .map_err(|e| MatchFailure::new(Rejection::of(&e), e.to_string()))?;
             if r.ill_conditioned {
-                return Err("the scans do not constrain the displacement (ill-conditioned)".into());
+                return Err(MatchFailure::new(
+                    Rejection::Conditioning,
+                    "the scans do not constrain the displacement (ill-conditioned)",
+                ));
             }
             Ok(MatchStats {
                 pose: r.pose,

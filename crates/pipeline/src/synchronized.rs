@@ -2,6 +2,7 @@
 //! ready for the solver and what was thrown away), read by the health checks and the
 //! clock-offset search.
 
+use crate::rejection::RejectionCounts;
 use crate::samples::PairSample;
 use crate::sync::{DiscardCounts, SyncLimits};
 
@@ -20,6 +21,8 @@ pub struct Synchronized {
     pub samples: Vec<PairSample>,
     /// Pairs discarded, per reason.
     pub discarded: DiscardCounts,
+    /// The pairs counted in `discarded` as `match_failed`, by the matcher's reason.
+    pub match_rejections: RejectionCounts,
     /// Clock offset used (s): laser clock minus encoder clock.
     pub time_offset: f64,
     /// The scans were swept and the samples were matched after moving every ray to

@@ -34,13 +34,14 @@ const SHOWN: [&str; 14] = [
 ];
 
 /// Keys of the "Data and solution" section, in order.
-const DATA_KEYS: [&str; 20] = [
+const DATA_KEYS: [&str; 21] = [
     "log_contents",
     "samples_used",
     "samples_synchronized",
     "samples_trimmed",
     "scan_pairs",
     "discarded",
+    "match_rejections",
     "stride",
     "interval_s",
     "ticks_per_revolution",

@@ -6,7 +6,7 @@ use odocal_geom::FlatParams;
 use odocal_log::Log;
 use odocal_pipeline::consistency::Consistency;
 use odocal_pipeline::sync::DiscardCounts;
-use odocal_pipeline::{Estimate, Finding, FindingKind, Options, Outcome, Timing};
+use odocal_pipeline::{Estimate, Finding, FindingKind, Options, Outcome, RejectionCounts, Timing};
 use odocal_solver::{Constraint, Observability, SharedScanNoise, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
@@ -42,6 +42,9 @@ pub struct Report {
     pub scan_pairs: usize,
     /// Scan pairs discarded before the solver, by reason.
     pub discarded: DiscardCounts,
+    /// The pairs discarded as `match_failed`, by the matcher's reason (overlap,
+    /// residuals, correction, correspondences, conditioning, ambiguity, …).
+    pub match_rejections: RejectionCounts,
     /// Scans between the two of a pair.
     pub stride: usize,
     /// Median interval between the two scans of a sample (s).
@@ -167,6 +170,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         samples_trimmed: outcome.synced.samples.len().saturating_sub(c.samples_used),
         scan_pairs: outcome.synced.pairs,
         discarded: outcome.synced.discarded.clone(),
+        match_rejections: outcome.synced.match_rejections.clone(),
         stride: e.stride,
         interval_s: e.interval_s,
         ticks_per_revolution: outcome.synced.ticks_per_revolution,
@@ -300,6 +304,22 @@ impl fmt::Display for Report {
             .map(|(k, n)| format!("{} {n}", k.replace('_', " ")))
             .collect();
         writeln!(f, "  discarded pairs: {}", d.join(", "))?;
+        if let Some((reason, n)) = self.match_rejections.most_common() {
+            let r: Vec<String> = self
+                .match_rejections
+                .0
+                .iter()
+                .filter(|(_, n)| **n > 0)
+                .map(|(k, n)| format!("{k} {n}"))
+                .collect();
+            writeln!(f, "  scan matches refused: {}", r.join(", "))?;
+            writeln!(
+                f,
+                "    most often {} ({n}): {}",
+                reason.key(),
+                reason.advice()
+            )?;
+        }
         writeln!(
             f,
             "  scan-matching noise σ: x {:.3} mm, y {:.3} mm, θ {:.4}°",
