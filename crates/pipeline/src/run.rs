@@ -266,6 +266,7 @@ pub fn synchronize_and_match(
             }
         }
     }
+    let match_self_check = crate::self_check::closure_check(&scans, &samples, &opts.icp);
     Ok(Synchronized {
         stride,
         limits,
@@ -274,6 +275,7 @@ pub fn synchronize_and_match(
         samples,
         discarded,
         match_rejections,
+        match_self_check,
         time_offset: opts.time_offset,
         sweep_compensated,
         read_time_sigma: None,

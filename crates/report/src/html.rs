@@ -34,7 +34,7 @@ const SHOWN: [&str; 14] = [
 ];
 
 /// Keys of the "Data and solution" section, in order.
-const DATA_KEYS: [&str; 21] = [
+const DATA_KEYS: [&str; 22] = [
     "log_contents",
     "samples_used",
     "samples_synchronized",
@@ -42,6 +42,7 @@ const DATA_KEYS: [&str; 21] = [
     "scan_pairs",
     "discarded",
     "match_rejections",
+    "match_self_check",
     "stride",
     "interval_s",
     "ticks_per_revolution",
