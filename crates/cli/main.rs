@@ -95,7 +95,8 @@ fn main() -> ExitCode {
             errln!("error: {e:#}");
             if json {
                 let args: Vec<String> = std::env::args().collect();
-                let _ = terminal::write_json_stdout(&json_error::error_object(&e, &args).to_string());
+                let _ =
+                    terminal::write_json_stdout(&json_error::error_object(&e, &args).to_string());
             }
             ExitCode::FAILURE
         }

@@ -28,14 +28,21 @@ pub(crate) fn robust_spread(squared_residuals: &mut [f64]) -> f64 {
     MAD_TO_SIGMA * median.sqrt()
 }
 
-/// The range noise the two scans show themselves: the larger of their estimates, at
-/// least the floor of exact data.
-pub(crate) fn scans_noise(reference: &PreparedScan, current: &PreparedScan) -> f64 {
+/// The range noise the two scans show themselves: the larger of their estimates; when
+/// neither scan has enough straight stretches to show its noise, the noise typical of
+/// the log ([`IcpParams::typical_noise_sigma`]); at least the floor of exact data.
+pub(crate) fn scans_noise(
+    reference: &PreparedScan,
+    current: &PreparedScan,
+    params: &IcpParams,
+) -> f64 {
     let range = reference.max_valid_range.max(current.max_valid_range);
-    reference
-        .noise_sigma
-        .max(current.noise_sigma)
-        .max(EXACT_NOISE_SHARE * range)
+    let own = match (reference.noise_sigma, current.noise_sigma) {
+        (Some(a), Some(b)) => a.max(b),
+        (Some(a), None) | (None, Some(a)) => a,
+        (None, None) => params.typical_noise_sigma,
+    };
+    own.max(EXACT_NOISE_SHARE * range)
 }
 
 /// Refuses a result whose residual spread is far above the scans' noise, or that

@@ -90,8 +90,15 @@ pub struct IcpParams {
     /// the noise there is correlated over 4 rays, which the windows partly absorb),
     /// wrong ones at 32× and more. Infinity disables the test.
     pub max_residual_to_noise: f64,
+    /// Range noise (σ, m) assumed by the consistency test for a pair of scans neither
+    /// of which has enough straight stretches to show its own noise (cluttered or
+    /// sparse scans: a fifth of the real URG-04LX scans of the MinesRover logs).
+    /// 0 (the default) takes such scans as noise-free, which refuses every match of
+    /// them whose residuals are not; the pipeline sets it to the median noise of the
+    /// log's scans.
+    pub typical_noise_sigma: f64,
     /// Consistency test: a match using fewer than this share of the current scan's
-    /// valid points is refused. On simulated URG-04LX pairs 0.4 s apart right matches
+    /// valid points that the reference could see at the result is refused. On simulated URG-04LX pairs 0.4 s apart right matches
     /// use 86–100 %, translations slid along a wall to a wrong but equally tight
     /// alignment 29–60 %.
     pub min_matched_share: f64,
@@ -131,6 +138,7 @@ impl Default for IcpParams {
             reference_noise_share: 0.5,
             min_incidence_cos: 0.2,
             max_residual_to_noise: 6.0,
+            typical_noise_sigma: 0.0,
             min_matched_share: 0.7,
             rotation_hypotheses: 3,
         }
@@ -193,6 +201,9 @@ impl IcpParams {
         }
         if self.max_residual_to_noise.is_nan() || self.max_residual_to_noise <= 0.0 {
             return bad("max_residual_to_noise must be positive (infinity: no test)");
+        }
+        if !(self.typical_noise_sigma.is_finite() && self.typical_noise_sigma >= 0.0) {
+            return bad("typical_noise_sigma must be finite and non-negative");
         }
         if !(0.0..=1.0).contains(&self.min_matched_share) {
             return bad("min_matched_share must be in [0, 1]");

@@ -70,9 +70,6 @@ pub struct PreparedScan {
     pub(crate) incidence_cos: Vec<f64>,
     /// Indices of the valid readings, increasing.
     pub(crate) valid_indices: Vec<u32>,
-    /// Valid readings on a usable local line (finite `incidence_cos`): the points a
-    /// right match can be expected to explain.
-    pub(crate) lined_count: usize,
     /// `segments[i]`: the local line of the segment from point `i` to `i + 1`, if usable.
     pub(crate) segments: Vec<Option<SegmentLine>>,
     /// Angles strictly increasing (required by the angular search).
@@ -85,8 +82,9 @@ pub struct PreparedScan {
     /// variance of its line's tilt (rad²), estimated from the scan itself.
     pub(crate) tilt_noise_scale: f64,
     /// Range-noise standard deviation (m) the scan shows itself: the scatter of its
-    /// points about their local lines (0 when it has fewer than 10 usable windows).
-    pub(crate) noise_sigma: f64,
+    /// points about their local lines (`None` when it has fewer than 10 usable
+    /// windows: unknown, which is not the same as noise-free).
+    pub(crate) noise_sigma: Option<f64>,
     /// k-d tree over the valid points, built when the k-d search is asked for or the
     /// angles do not allow the angular search.
     pub(crate) tree: Option<PointTree>,
@@ -186,7 +184,6 @@ impl PreparedScan {
                 }
             })
             .collect::<Vec<f64>>();
-        let lined_count = incidence_cos.iter().filter(|c| !c.is_nan()).count();
         // The direction between consecutive points of a usable segment is, up to its
         // sign, the tangent of the segment's local line.
         let unit_towards = |line: &SegmentLine, from: usize, to: usize| {
@@ -233,7 +230,6 @@ impl PreparedScan {
             valid,
             incidence_cos,
             valid_indices,
-            lined_count,
             segments,
             angles_increasing,
             uniform,
@@ -242,6 +238,12 @@ impl PreparedScan {
             noise_sigma,
             tree,
         })
+    }
+
+    /// Range noise the scan shows about its own local lines (σ, m; `None` when it has
+    /// too few straight stretches to tell).
+    pub fn noise_sigma(&self) -> Option<f64> {
+        self.noise_sigma
     }
 
     /// Number of readings (valid or not).
@@ -361,7 +363,7 @@ fn local_lines(
     inv_ranges: &[f64],
     connected: &[bool],
     params: &IcpParams,
-) -> (Vec<Option<SegmentLine>>, f64, f64) {
+) -> (Vec<Option<SegmentLine>>, f64, Option<f64>) {
     let n = points.len();
     // Range-noise variance of each disjoint window on a straight surface.
     let mut range_variances: Vec<f64> = Vec::new();
@@ -487,14 +489,14 @@ const MIN_NOISE_COS2: f64 = 0.04;
 /// windows: the square root of their median, robust to the windows on bends and
 /// corners. Range noise correlated over neighbouring rays partly moves a window as a
 /// whole, so that on such sensors it is below the per-ray σ (≈ 0.6 σ for the
-/// simulated URG-04LX). 0 when fewer than 10 windows.
-fn noise_scale(variances: &mut [f64]) -> f64 {
+/// simulated URG-04LX). `None` (unknown) when fewer than 10 windows.
+fn noise_scale(variances: &mut [f64]) -> Option<f64> {
     if variances.len() < 10 {
-        return 0.0;
+        return None;
     }
     let mid = variances.len() / 2;
     let (_, median, _) = variances.select_nth_unstable_by(mid, f64::total_cmp);
-    median.sqrt()
+    Some(median.sqrt())
 }
 
 /// Range-noise variance that, times a line's `tilt_variance`, gives the variance of

@@ -12,7 +12,9 @@ use crate::finding::Finding;
 use crate::log_agreement::{check_log, information_shares};
 use crate::options::{Options, MIN_SAMPLES};
 use crate::progress::Progress;
+use crate::rejection::RejectionCounts;
 use crate::run::{calibrate_log, refuse_poorly_determined, Outcome, Timing};
+use crate::self_check::MatchSelfCheck;
 use crate::sync::DiscardCounts;
 use crate::synchronized::Synchronized;
 use odocal_log::Log;
@@ -245,8 +247,16 @@ fn merged(outcomes: &[Outcome]) -> Synchronized {
             *discarded.0.entry(k).or_insert(0) += n;
         }
     }
+    let mut match_rejections = RejectionCounts::default();
+    for o in outcomes {
+        for (k, n) in &o.synced.match_rejections.0 {
+            *match_rejections.0.entry(k).or_insert(0) += n;
+        }
+    }
     let first = &outcomes[0].synced;
     Synchronized {
+        match_rejections,
+        match_self_check: pooled_self_check(outcomes),
         stride: first.stride,
         limits: first.limits,
         ticks_per_revolution: first.ticks_per_revolution,
@@ -268,4 +278,34 @@ fn merged(outcomes: &[Outcome]) -> Synchronized {
             (!causes.is_empty()).then(|| causes.join("; "))
         },
     }
+}
+
+/// The logs' scan-matching self-checks pooled: RMS errors weighted by the triples
+/// that closed in each log (`None` when no log had enough).
+fn pooled_self_check(outcomes: &[Outcome]) -> Option<MatchSelfCheck> {
+    let checks: Vec<&MatchSelfCheck> = outcomes
+        .iter()
+        .filter_map(|o| o.synced.match_self_check.as_ref())
+        .collect();
+    let triples: usize = checks.iter().map(|c| c.triples).sum();
+    if triples == 0 {
+        return None;
+    }
+    let mean_square = |f: fn(&MatchSelfCheck) -> f64| {
+        (checks
+            .iter()
+            .map(|c| c.triples as f64 * f(c).powi(2))
+            .sum::<f64>()
+            / triples as f64)
+            .sqrt()
+    };
+    let mut noise: Vec<f64> = checks.iter().map(|c| c.range_noise_m).collect();
+    noise.sort_by(f64::total_cmp);
+    Some(MatchSelfCheck {
+        triples,
+        tried: checks.iter().map(|c| c.tried).sum(),
+        xy_m: mean_square(|c| c.xy_m),
+        theta_rad: mean_square(|c| c.theta_rad),
+        range_noise_m: noise[noise.len() / 2],
+    })
 }

@@ -15,7 +15,8 @@
 //! Stages, one module each: [`sync`] (encoder interpolation at the scan timestamps,
 //! encoder profile, discards by reason), [`sweep`] (rays of a sweeping laser moved to
 //! the sensor frame at the scan's reference time), [`matching`] (ICP over the pairs, in
-//! parallel with [`parallel`]), [`health`] (data faults found, repaired and named,
+//! parallel with [`parallel`]; refusals counted by reason in [`rejection`]; the matcher's own error by closure of scan
+//! triples in [`self_check`]), [`health`] (data faults found, repaired and named,
 //! before and after matching, as [`finding`]s: what the results want a reader to
 //! notice), [`time_offset`] (optional clock-offset search), [`options`] (what the pipeline can be told),
 //! [`synchronized`] (the per-log samples between synchronization and the solve),
@@ -41,8 +42,10 @@ pub mod options;
 pub mod parallel;
 mod progress;
 pub mod refusal;
+pub mod rejection;
 pub mod run;
 pub mod samples;
+pub mod self_check;
 pub mod sweep;
 pub mod sync;
 pub mod synchronized;
@@ -58,6 +61,7 @@ pub use joint::{calibrate_logs, Contribution, JointError, JointOutcome};
 pub use odocal_solver::Trim;
 pub use options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 pub use progress::{NoProgress, Progress};
+pub use rejection::{MatchFailure, Rejection, RejectionCounts};
 pub use run::{calibrate_log, synchronize_and_match, Outcome, Timing};
 pub use samples::write_tuples;
 pub use synchronized::Synchronized;

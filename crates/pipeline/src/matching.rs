@@ -1,6 +1,7 @@
 //! The scan-matching stage: ŝ for every synchronized pair, in parallel.
 
 use crate::parallel::match_chain;
+use crate::rejection::{MatchFailure, Rejection};
 use odocal_geom::Pose2;
 use odocal_icp::{IcpParams, Matcher, PreparedScan};
 use odocal_log::ScanStore;
@@ -21,17 +22,57 @@ pub struct MatchStats {
     pub mean_residual: f64,
 }
 
+/// Scans sampled to estimate the log's typical range noise.
+const NOISE_SAMPLE_SCANS: usize = 64;
+
+/// The median range noise (σ, m) of up to [`NOISE_SAMPLE_SCANS`] scans spread evenly
+/// over the store, among those whose noise shows (straight stretches); 0 when none
+/// does. What the matcher's consistency test assumes for scans too cluttered or
+/// sparse to show their own.
+pub fn typical_noise_sigma(scans: &ScanStore, params: &IcpParams) -> f64 {
+    let every = (scans.len() / NOISE_SAMPLE_SCANS).max(1);
+    let mut noise: Vec<f64> = (0..scans.len())
+        .step_by(every)
+        .filter_map(|i| {
+            let s = scans.get(i)?;
+            PreparedScan::new(
+                s.ranges,
+                &s.geometry.angles,
+                s.geometry.min_range,
+                s.geometry.max_range,
+                params,
+            )
+            .ok()?
+            .noise_sigma()
+        })
+        .collect();
+    if noise.is_empty() {
+        return 0.0;
+    }
+    let mid = noise.len() / 2;
+    *noise.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
 /// Matches the pairs `(first, second)` of scan indices, each with its first guess,
 /// in parallel (rayon's current pool). Results come back in pair order and do not
 /// depend on the number of threads. `done` is called once per pair (progress).
+/// Without a [`IcpParams::typical_noise_sigma`], the store's own
+/// ([`typical_noise_sigma`]) is used.
 pub fn match_pairs(
     scans: &ScanStore,
     pairs: &[(usize, usize)],
     first_guesses: &[Pose2],
     params: &IcpParams,
     done: impl Fn() + Sync + Send,
-) -> Vec<Result<MatchStats, String>> {
+) -> Vec<Result<MatchStats, MatchFailure>> {
     debug_assert_eq!(pairs.len(), first_guesses.len());
+    let mut own_params;
+    let mut params = params;
+    if params.typical_noise_sigma == 0.0 {
+        own_params = params.clone();
+        own_params.typical_noise_sigma = typical_noise_sigma(scans, params);
+        params = &own_params;
+    }
     let prepare = |i: usize| match scans.get(i) {
         Some(s) => PreparedScan::new(
             s.ranges,
@@ -40,8 +81,16 @@ pub fn match_pairs(
             s.geometry.max_range,
             params,
         )
-        .map_err(|e| format!("scan {i} (line {}): {e}", s.line)),
-        None => Err(format!("scan {i} does not exist")),
+        .map_err(|e| {
+            MatchFailure::new(
+                Rejection::of(&e),
+                format!("scan {i} (line {}): {e}", s.line),
+            )
+        }),
+        None => Err(MatchFailure::new(
+            Rejection::Scan,
+            format!("scan {i} does not exist"),
+        )),
     };
     match_chain(
         pairs,
@@ -54,9 +103,12 @@ pub fn match_pairs(
             };
             let r = matcher
                 .match_scans(reference, current, first_guesses[k])
-                .map_err(|e| e.to_string())?;
+                .map_err(|e| MatchFailure::new(Rejection::of(&e), e.to_string()))?;
             if r.ill_conditioned {
-                return Err("the scans do not constrain the displacement (ill-conditioned)".into());
+                return Err(MatchFailure::new(
+                    Rejection::Conditioning,
+                    "the scans do not constrain the displacement (ill-conditioned)",
+                ));
             }
             Ok(MatchStats {
                 pose: r.pose,

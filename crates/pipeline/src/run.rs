@@ -8,6 +8,7 @@ use crate::matching::{match_pairs, MatchStats};
 use crate::options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 use crate::progress::Progress;
 use crate::refusal;
+use crate::rejection::{MatchFailure, Rejection, RejectionCounts};
 use crate::samples::PairSample;
 use crate::sweep::{compensated_pairs, has_sweep, reference_time};
 use crate::sync::{
@@ -165,7 +166,7 @@ pub fn synchronize_and_match(
         .map(|(k, _)| (pairs[*k].first, pairs[*k].second))
         .collect();
     progress.start("matching", index_pairs.len());
-    let mut matched: Vec<Option<Result<MatchStats, String>>> = vec![None; kept.len()];
+    let mut matched: Vec<Option<Result<MatchStats, MatchFailure>>> = vec![None; kept.len()];
     let mut guess_params = opts.initial_params;
     let bootstrap = (opts.bootstrap_guesses || sweep) && kept.len() >= MIN_SAMPLES;
     if guess_params.is_none() && bootstrap {
@@ -232,7 +233,12 @@ pub fn synchronize_and_match(
         scans = Cow::Owned(store);
         for (i, ok) in covered.into_iter().enumerate() {
             uncovered[i] = !ok;
-            matched[i] = (!ok).then(|| Err("the encoders do not cover the sweep".into()));
+            matched[i] = (!ok).then(|| {
+                Err(MatchFailure::new(
+                    Rejection::Other,
+                    "the encoders do not cover the sweep",
+                ))
+            });
         }
     }
     let rest: Vec<usize> = (0..kept.len()).filter(|&i| matched[i].is_none()).collect();
@@ -251,17 +257,22 @@ pub fn synchronize_and_match(
     timing.r#match += t_match.elapsed().as_secs_f64();
 
     let mut samples = Vec::with_capacity(kept.len());
+    let mut match_rejections = RejectionCounts::default();
     for (((k, wheel), m), uncovered) in kept.into_iter().zip(matched).zip(uncovered) {
-        match m.unwrap_or_else(|| Err("not matched".into())) {
+        match m.unwrap_or_else(|| Err(MatchFailure::new(Rejection::Other, "not matched"))) {
             Ok(icp) => samples.push(PairSample {
                 pair: pairs[k],
                 wheel,
                 icp,
             }),
             Err(_) if uncovered => discarded.add(DiscardReason::EncoderGap),
-            Err(_) => discarded.add(DiscardReason::MatchFailed),
+            Err(f) => {
+                discarded.add(DiscardReason::MatchFailed);
+                match_rejections.add(f.reason);
+            }
         }
     }
+    let match_self_check = crate::self_check::closure_check(&scans, &samples, &opts.icp);
     Ok(Synchronized {
         stride,
         limits,
@@ -269,6 +280,8 @@ pub fn synchronize_and_match(
         pairs: pairs.len(),
         samples,
         discarded,
+        match_rejections,
+        match_self_check,
         time_offset: opts.time_offset,
         sweep_compensated,
         read_time_sigma: None,
@@ -314,7 +327,7 @@ fn second_pass(
         (Cow::Borrowed(&log.scans), vec![true; index_pairs.len()])
     };
     progress.start("matching (second pass)", index_pairs.len());
-    let matched: Vec<Result<MatchStats, String>> =
+    let matched: Vec<Result<MatchStats, MatchFailure>> =
         match_pairs(&scans, &index_pairs, &guesses, &opts.icp, || {
             progress.advance()
         });
@@ -324,7 +337,10 @@ fn second_pass(
         match m {
             Ok(icp) if covered => synced.samples.push(PairSample { icp, ..s }),
             Ok(_) => synced.discarded.add(DiscardReason::EncoderGap),
-            Err(_) => synced.discarded.add(DiscardReason::MatchFailed),
+            Err(f) => {
+                synced.discarded.add(DiscardReason::MatchFailed);
+                synced.match_rejections.add(f.reason);
+            }
         }
     }
 }

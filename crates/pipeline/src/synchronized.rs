@@ -2,7 +2,9 @@
 //! ready for the solver and what was thrown away), read by the health checks and the
 //! clock-offset search.
 
+use crate::rejection::RejectionCounts;
 use crate::samples::PairSample;
+use crate::self_check::MatchSelfCheck;
 use crate::sync::{DiscardCounts, SyncLimits};
 
 /// Samples ready for the solver, and what was thrown away.
@@ -20,6 +22,11 @@ pub struct Synchronized {
     pub samples: Vec<PairSample>,
     /// Pairs discarded, per reason.
     pub discarded: DiscardCounts,
+    /// The pairs counted in `discarded` as `match_failed`, by the matcher's reason.
+    pub match_rejections: RejectionCounts,
+    /// The matcher's own error per pair, from the closure of scan triples (see
+    /// [`crate::self_check`]); `None` when too few triples close.
+    pub match_self_check: Option<MatchSelfCheck>,
     /// Clock offset used (s): laser clock minus encoder clock.
     pub time_offset: f64,
     /// The scans were swept and the samples were matched after moving every ray to

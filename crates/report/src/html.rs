@@ -37,13 +37,15 @@ const SHOWN: [&str; 17] = [
 ];
 
 /// Keys of the "Data and solution" section, in order.
-const DATA_KEYS: [&str; 21] = [
+const DATA_KEYS: [&str; 23] = [
     "log_contents",
     "samples_used",
     "samples_synchronized",
     "samples_trimmed",
     "scan_pairs",
     "discarded",
+    "match_rejections",
+    "match_self_check",
     "stride",
     "interval_s",
     "ticks_per_revolution",

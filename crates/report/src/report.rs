@@ -5,8 +5,9 @@ use crate::provenance::Provenance;
 use odocal_geom::FlatParams;
 use odocal_log::Log;
 use odocal_pipeline::consistency::Consistency;
+use odocal_pipeline::self_check::MatchSelfCheck;
 use odocal_pipeline::sync::DiscardCounts;
-use odocal_pipeline::{Estimate, Finding, FindingKind, Options, Outcome, Timing};
+use odocal_pipeline::{Estimate, Finding, FindingKind, Options, Outcome, RejectionCounts, Timing};
 use odocal_solver::{Constraint, Observability, SharedScanNoise, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
@@ -42,6 +43,12 @@ pub struct Report {
     pub scan_pairs: usize,
     /// Scan pairs discarded before the solver, by reason.
     pub discarded: DiscardCounts,
+    /// The pairs discarded as `match_failed`, by the matcher's reason (overlap,
+    /// residuals, correction, correspondences, conditioning, ambiguity, …).
+    pub match_rejections: RejectionCounts,
+    /// The scan matcher's own error per pair, measured on this log by the closure of
+    /// scan triples; absent when too few triples close.
+    pub match_self_check: Option<MatchSelfCheck>,
     /// Scans between the two of a pair.
     pub stride: usize,
     /// Median interval between the two scans of a sample (s).
@@ -199,6 +206,8 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         samples_trimmed: outcome.synced.samples.len().saturating_sub(c.samples_used),
         scan_pairs: outcome.synced.pairs,
         discarded: outcome.synced.discarded.clone(),
+        match_rejections: outcome.synced.match_rejections.clone(),
+        match_self_check: outcome.synced.match_self_check,
         stride: e.stride,
         interval_s: e.interval_s,
         ticks_per_revolution: outcome.synced.ticks_per_revolution,
@@ -336,6 +345,36 @@ impl fmt::Display for Report {
             .map(|(k, n)| format!("{} {n}", k.replace('_', " ")))
             .collect();
         writeln!(f, "  discarded pairs: {}", d.join(", "))?;
+        if let Some((reason, n)) = self.match_rejections.most_common() {
+            let r: Vec<String> = self
+                .match_rejections
+                .0
+                .iter()
+                .filter(|(_, n)| **n > 0)
+                .map(|(k, n)| format!("{k} {n}"))
+                .collect();
+            writeln!(f, "  scan matches refused: {}", r.join(", "))?;
+            writeln!(
+                f,
+                "    most often {} ({n}): {}",
+                reason.key(),
+                reason.advice()
+            )?;
+        }
+        if let Some(c) = &self.match_self_check {
+            let ratio = if c.range_noise_m > 0.0 {
+                format!(", {:.1}× the laser's range noise", c.xy_m / c.range_noise_m)
+            } else {
+                String::new()
+            };
+            writeln!(
+                f,
+                "  scan matching on this log: {:.2} mm / {:.3}° per pair{ratio} (closure of {} scan triples: a lower bound, errors shared between matches of one scan do not show)",
+                c.xy_m * 1e3,
+                c.theta_rad.to_degrees(),
+                c.triples
+            )?;
+        }
         writeln!(
             f,
             "  scan-matching noise σ: x {:.3} mm, y {:.3} mm, θ {:.4}°",
