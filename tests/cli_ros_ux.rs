@@ -145,15 +145,17 @@ fn a_refusal_under_json_is_a_json_object_with_the_message_kind_and_command() {
         command.contains(&bag) && command.contains("--nominal"),
         "{v}"
     );
-    // A parameter the data do not determine: the refusal names --accept-weak.
+    // Parameters the data do not determine: the refusal's kind, and its command holds
+    // the parameters it proposes to hold.
     let short = root("fixtures/bags/turtlebot_tf.bag");
     let out = odocal(&["calibrate", &short, "--json"]);
     assert!(!out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["kind"], "not_determined", "{v}");
     assert!(
         v["suggested_command"]
             .as_str()
-            .is_some_and(|c| c.ends_with("--accept-weak")),
+            .is_some_and(|c| c.contains(&short) && c.contains("--fix")),
         "{v}"
     );
     // info on a file that is not there.

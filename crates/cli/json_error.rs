@@ -3,15 +3,18 @@
 //! refused, "suggested_command": the same command with the flag the message asks
 //! for}` (the last only when the message asks for one); the exit code stays non-zero.
 
+use crate::partial_args::HoldRefusal;
 use odocal_log::LogError;
 use odocal_pipeline::PipelineError;
 use serde_json::{json, Value};
 
 /// The JSON object describing `error` for the command line `args`.
 pub fn error_object(error: &anyhow::Error, args: &[String]) -> Value {
+    let hold = error.chain().find_map(|e| e.downcast_ref::<HoldRefusal>());
     let pipeline = error
         .chain()
-        .find_map(|e| e.downcast_ref::<PipelineError>());
+        .find_map(|e| e.downcast_ref::<PipelineError>())
+        .or(hold.map(|h| &h.refusal));
     let kind = match pipeline {
         Some(PipelineError::Log(_)) => "log",
         Some(PipelineError::TooFewSamples { .. }) => "too_few_samples",
@@ -26,7 +29,10 @@ pub fn error_object(error: &anyhow::Error, args: &[String]) -> Value {
     };
     let message = format!("{error:#}");
     let mut object = json!({ "error": message, "kind": kind });
-    if let Some(flag) = suggested_flag(pipeline, &message) {
+    if let Some(h) = hold {
+        // The refusal's own command: the parameters to hold (MEASURED to fill in).
+        object["suggested_command"] = h.command.clone().into();
+    } else if let Some(flag) = suggested_flag(pipeline, &message) {
         let mut command: Vec<&str> = args.iter().map(String::as_str).collect();
         command.push(flag);
         object["suggested_command"] = command.join(" ").into();

@@ -52,16 +52,41 @@ pub fn with_hold_command(e: odocal_pipeline::PipelineError) -> anyhow::Error {
     let mut words: Vec<String> = vec!["odocal".into()];
     words.extend(std::env::args().skip(1).map(|a| shell_word(&a)));
     words.extend(holds.iter().map(|h| h.argument()));
-    let measure = if holds.iter().any(|h| h.value.is_none()) {
-        " (put the measured value in place of MEASURED)"
-    } else {
-        ""
-    };
-    anyhow::anyhow!(
-        "{e}\nto calibrate the other parameters, run{measure}:\n  {}",
-        words.join(" ")
-    )
+    HoldRefusal {
+        measure: holds.iter().any(|h| h.value.is_none()),
+        command: words.join(" "),
+        refusal: e,
+    }
+    .into()
 }
+
+/// A refusal and the command that calibrates the other parameters with some held.
+#[derive(Debug)]
+pub struct HoldRefusal {
+    /// The pipeline's refusal.
+    pub refusal: odocal_pipeline::PipelineError,
+    /// The command line to run.
+    pub command: String,
+    /// Some held value must be measured (`MEASURED` stands in the command).
+    pub measure: bool,
+}
+
+impl std::fmt::Display for HoldRefusal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let measure = if self.measure {
+            " (put the measured value in place of MEASURED)"
+        } else {
+            ""
+        };
+        write!(
+            f,
+            "{}\nto calibrate the other parameters, run{measure}:\n  {}",
+            self.refusal, self.command
+        )
+    }
+}
+
+impl std::error::Error for HoldRefusal {}
 
 /// An argument as a POSIX shell word (quoted when it holds anything but plain characters).
 fn shell_word(a: &str) -> String {
