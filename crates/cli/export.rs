@@ -16,7 +16,7 @@ use std::path::PathBuf;
 pub enum Format {
     /// ros2_control diff_drive_controller parameters (YAML).
     Ros2Control,
-    /// The laser joint's URDF <origin xyz rpy>.
+    /// The laser joint's URDF `<origin xyz rpy>`.
     Urdf,
 }
 

@@ -23,7 +23,7 @@ pub struct MatchStats {
 }
 
 /// Scans sampled to estimate the log's typical range noise.
-const NOISE_SAMPLE_SCANS: usize = 64;
+pub const NOISE_SAMPLE_SCANS: usize = 64;
 
 /// The median range noise (σ, m) of up to [`NOISE_SAMPLE_SCANS`] scans spread evenly
 /// over the store, among those whose noise shows (straight stretches); 0 when none

@@ -424,7 +424,7 @@ pub(crate) fn refuse_poorly_determined(
                     Some(_) => Vec::new(),
                     None => refusal::holds(
                         samples,
-                        &solve_options,
+                        solve_options,
                         &calibration,
                         opts.initial_params.as_ref(),
                     ),
