@@ -20,10 +20,11 @@ fn mines_log(name: &str) -> Option<PathBuf> {
 
 #[test]
 fn most_pairs_of_the_real_mines_logs_match_and_every_refusal_has_its_reason() {
-    // (log, share of the moving pairs matched at least): measured 109/175 (62 %) and
-    // 88/147 (60 %) (docs/benchmarks.md); before the visibility-aware overlap and the
-    // typical noise for scans that show none, 89/175 (51 %) and 66/147 (45 %).
-    for (name, min_yield) in [("exp1.log", 0.55), ("exp2.log", 0.55)] {
+    // (log, share of the moving pairs matched at least): measured 89/175 (51 %) and
+    // 66/147 (45 %) (docs/benchmarks.md; 81 and 59 before this stop). A visibility-aware
+    // overlap gave 109 and 88 but accepted wrong matches in the basin grid, and was
+    // withdrawn: the yield target of issue 20 is not met.
+    for (name, min_yield) in [("exp1.log", 0.49), ("exp2.log", 0.43)] {
         let Some(path) = mines_log(name) else { return };
         let log = odocal_log::read_log(&path, &Default::default()).unwrap();
         let opts = Options {

@@ -36,9 +36,8 @@
 //!    the first guess there and is flagged `ill_conditioned`. A result too far from
 //!    the first guess, NaN, or too few matches is an [`IcpError`].
 //! 7. `consistency`: a result whose residual spread is far above the range noise the
-//!    two scans show themselves, or that uses too few of the current scan's points the
-//!    reference could see (`visibility`: in its field of view, where it had a
-//!    return), is a wrong local minimum and is refused.
+//!    two scans show themselves, or that uses too few of the current scan's points,
+//!    is a wrong local minimum and is refused.
 //! 8. `rotation_search`: when the attempt from the first guess fails or is refused,
 //!    the matcher starts again from the rotations where the two scans' histograms of
 //!    line directions agree best (translation-independent); two distinct consistent
@@ -68,7 +67,6 @@ mod preprocess;
 mod rotation_search;
 mod solve_step;
 mod trimming;
-mod visibility;
 
 pub use error::IcpError;
 pub use matcher::{IcpResult, Matcher};

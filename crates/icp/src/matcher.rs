@@ -6,7 +6,6 @@ use crate::covariance::{conditioning, InformationSum, RayResiduals};
 use crate::rotation_search::candidate_rotations;
 use crate::solve_step::NormalEquations;
 use crate::trimming::threshold;
-use crate::visibility::visible_count;
 use crate::{IcpError, IcpParams, NeighbourSearch, PreparedScan};
 use odocal_geom::{wrap_angle, Pose2};
 
@@ -64,8 +63,7 @@ pub struct IcpResult {
     /// floor for exact data; see [`IcpParams::max_residual_to_noise`].
     pub noise_sigma: f64,
     /// Correspondences used in the final step per valid point of the current scan on
-    /// a usable local line that the reference could see at the result (in its field
-    /// of view, where it had a return; at most 1).
+    /// a usable local line (at most 1).
     pub matched_share: f64,
     /// Starting points tried: 1 when the first guess led to the result.
     pub starts: u32,
@@ -509,9 +507,7 @@ impl Matcher {
             weakest_direction: unc.weakest_direction,
             residual_spread: robust_spread(&mut self.squared_residuals),
             noise_sigma: scans_noise(reference, current, params),
-            matched_share: (used as f64
-                / visible_count(reference, current, &estimate).max(1) as f64)
-                .min(1.0),
+            matched_share: (used as f64 / current.lined_count.max(1) as f64).min(1.0),
             starts: 1,
         };
         check_consistency(&result, params)?;

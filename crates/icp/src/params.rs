@@ -98,7 +98,7 @@ pub struct IcpParams {
     /// log's scans.
     pub typical_noise_sigma: f64,
     /// Consistency test: a match using fewer than this share of the current scan's
-    /// valid points that the reference could see at the result is refused. On simulated URG-04LX pairs 0.4 s apart right matches
+    /// valid points on a usable local line is refused. On simulated URG-04LX pairs 0.4 s apart right matches
     /// use 86–100 %, translations slid along a wall to a wrong but equally tight
     /// alignment 29–60 %.
     pub min_matched_share: f64,

@@ -70,6 +70,9 @@ pub struct PreparedScan {
     pub(crate) incidence_cos: Vec<f64>,
     /// Indices of the valid readings, increasing.
     pub(crate) valid_indices: Vec<u32>,
+    /// Valid readings on a usable local line (finite `incidence_cos`): the points a
+    /// right match can be expected to explain.
+    pub(crate) lined_count: usize,
     /// `segments[i]`: the local line of the segment from point `i` to `i + 1`, if usable.
     pub(crate) segments: Vec<Option<SegmentLine>>,
     /// Angles strictly increasing (required by the angular search).
@@ -184,6 +187,7 @@ impl PreparedScan {
                 }
             })
             .collect::<Vec<f64>>();
+        let lined_count = incidence_cos.iter().filter(|c| !c.is_nan()).count();
         // The direction between consecutive points of a usable segment is, up to its
         // sign, the tangent of the segment's local line.
         let unit_towards = |line: &SegmentLine, from: usize, to: usize| {
@@ -230,6 +234,7 @@ impl PreparedScan {
             valid,
             incidence_cos,
             valid_indices,
+            lined_count,
             segments,
             angles_increasing,
             uniform,

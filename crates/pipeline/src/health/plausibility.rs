@@ -88,7 +88,7 @@ fn check_flaser_geometry(log: &Log) -> Result<(), PipelineError> {
         return Ok(());
     };
     Err(PipelineError::Implausible(format!(
-        "the FLASER scans (first at line {}) carry no field of view and no PARAM gives it:          the reader assumed π rad, and a wrong field of view biases every parameter; add          the laser's value before the first FLASER line, e.g.          `PARAM laser_front_laser_fov 3.14159265` (rad, first to last ray) or          `PARAM laser_front_laser_resolution 0.01745329` (rad between rays)",
+        "the FLASER scans (first at line {}) carry no field of view and no PARAM gives it: the reader assumed π rad, and a wrong field of view biases every parameter; add the laser's value before the first FLASER line, e.g. `PARAM laser_front_laser_fov 3.14159265` (rad, first to last ray) or `PARAM laser_front_laser_resolution 0.01745329` (rad between rays)",
         first.line
     )))
 }
