@@ -1,6 +1,7 @@
 //! `odocal calibrate LOG [LOG …]`: raw logs in, calibrated robot out (several logs of
 //! one robot are calibrated jointly).
 
+use crate::heading_refusal::with_joint_states_command;
 use crate::input::InputArgs;
 use crate::nominal::{describe, odometry_only_mode};
 use crate::output_paths::{check_dir_output, check_file_output};
@@ -134,6 +135,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let parse_s = t_parse.elapsed().as_secs_f64();
     // The laser's nominal pose from the first bag with static transforms.
     let laser = inputs.iter().find_map(|r| r.nominal_laser.clone());
+    // The bag's wheel joint states and IMU topics, for a gyro-heading refusal.
+    let heading_sources = inputs.iter().find_map(|r| r.heading_sources.clone());
+    let refused = |e| match with_joint_states_command(e, heading_sources.as_ref()) {
+        Ok(heading) => anyhow::Error::from(heading),
+        Err(e) => crate::partial_args::with_hold_command(e),
+    };
     let (mut logs, mut checksums): (Vec<Log>, Vec<Option<(String, u64)>>) =
         inputs.into_iter().map(|r| (r.log, r.checksum)).unzip();
 
@@ -156,6 +163,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         second_pass: args.second_pass,
         bootstrap_guesses: !args.identity_guess,
         accept_weak: args.partial.accept_weak,
+        odometry_only: odometry_only.is_some(),
         ..Options::default()
     };
     opts.solve.trim = args.trim.into();
@@ -166,7 +174,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let (mut outcome, mut report) = if let [log] = &logs[..] {
         let outcome = pool
             .install(|| calibrate_log(log, &opts, &bar))
-            .map_err(crate::partial_args::with_hold_command)?;
+            .map_err(refused)?;
         let report = build_report(paths[0], log, &opts, &outcome);
         (outcome, report)
     } else {

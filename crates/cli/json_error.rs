@@ -3,6 +3,7 @@
 //! refused, "suggested_command": the same command with the flag the message asks
 //! for}` (the last only when the message asks for one); the exit code stays non-zero.
 
+use crate::heading_refusal::HeadingRefusal;
 use crate::partial_args::HoldRefusal;
 use odocal_log::LogError;
 use odocal_pipeline::PipelineError;
@@ -11,10 +12,14 @@ use serde_json::{json, Value};
 /// The JSON object describing `error` for the command line `args`.
 pub fn error_object(error: &anyhow::Error, args: &[String]) -> Value {
     let hold = error.chain().find_map(|e| e.downcast_ref::<HoldRefusal>());
+    let heading = error
+        .chain()
+        .find_map(|e| e.downcast_ref::<HeadingRefusal>());
     let pipeline = error
         .chain()
         .find_map(|e| e.downcast_ref::<PipelineError>())
-        .or(hold.map(|h| &h.refusal));
+        .or(hold.map(|h| &h.refusal))
+        .or(heading.map(|h| &h.refusal));
     let kind = match pipeline {
         Some(PipelineError::Log(_)) => "log",
         Some(PipelineError::TooFewSamples { .. }) => "too_few_samples",
@@ -29,7 +34,10 @@ pub fn error_object(error: &anyhow::Error, args: &[String]) -> Value {
     };
     let message = format!("{error:#}");
     let mut object = json!({ "error": message, "kind": kind });
-    if let Some(h) = hold {
+    if let Some(command) = heading.and_then(|h| h.command.as_ref()) {
+        // A gyro-heading refusal: calibrate from the bag's wheel joint states.
+        object["suggested_command"] = command.clone().into();
+    } else if let Some(h) = hold {
         // The refusal's own command: the parameters to hold (MEASURED to fill in).
         object["suggested_command"] = h.command.clone().into();
     } else if let Some(flag) = suggested_flag(pipeline, &message) {

@@ -89,7 +89,7 @@ impl std::fmt::Display for HoldRefusal {
 impl std::error::Error for HoldRefusal {}
 
 /// An argument as a POSIX shell word (quoted when it holds anything but plain characters).
-fn shell_word(a: &str) -> String {
+pub fn shell_word(a: &str) -> String {
     let plain = !a.is_empty()
         && a.chars()
             .all(|c| c.is_ascii_alphanumeric() || "-_./=,:+@%".contains(c));

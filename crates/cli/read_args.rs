@@ -136,6 +136,7 @@ impl ReadArgs {
                 errln!("warning: {w}");
             }
             return Ok(ReadInput {
+                heading_sources: Some(odocal_bag::heading_sources(&bag.topics)),
                 log: bag.log,
                 checksum: None,
                 nominal_laser: bag.nominal_laser,
@@ -158,6 +159,7 @@ impl ReadArgs {
             log,
             checksum: Some(checksum),
             nominal_laser: None,
+            heading_sources: None,
         })
     }
 }
@@ -171,6 +173,8 @@ pub struct ReadInput {
     pub checksum: Option<(String, u64)>,
     /// The laser's pose from a bag's static transforms, when it has them.
     pub nominal_laser: Option<NominalLaser>,
+    /// A bag's joint-state and IMU topics (for the odometry-only heading refusal).
+    pub heading_sources: Option<odocal_bag::HeadingSources>,
 }
 
 /// The input path as given, except that a ROS 2 bag's `metadata.yaml` stands for its

@@ -19,6 +19,7 @@
 mod collect;
 mod detect;
 mod error;
+mod heading_sources;
 pub mod limits;
 mod mcap_source;
 mod messages;
@@ -35,6 +36,7 @@ mod zstd_input;
 pub use collect::{Collected, DecodeFilter, TopicStats};
 pub use detect::{bag_format_of_head, detect_bag, BagFormat};
 pub use error::BagError;
+pub use heading_sources::{heading_sources, HeadingSources};
 pub use messages::{normalize_type, MessageKind, ScanFields};
 pub use select::{Selection, TopicChoice, WheelSource};
 pub use tf::NominalLaser;

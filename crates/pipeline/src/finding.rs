@@ -38,6 +38,9 @@ pub enum FindingKind {
     ReadJitter,
     /// One log of a joint calibration against the joint estimate.
     LogAgreement,
+    /// Odometry-only mode on odometry whose heading is not integrated from the wheels
+    /// (a gyro's or a filter's).
+    GyroHeading,
 }
 
 impl FindingKind {
@@ -58,6 +61,7 @@ impl FindingKind {
             FindingKind::TwoHalves => "two_halves",
             FindingKind::ReadJitter => "read_jitter",
             FindingKind::LogAgreement => "log_agreement",
+            FindingKind::GyroHeading => "gyro_heading",
         }
     }
 }

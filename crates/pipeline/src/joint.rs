@@ -277,6 +277,13 @@ fn merged(outcomes: &[Outcome]) -> Synchronized {
                 .collect();
             (!causes.is_empty()).then(|| causes.join("; "))
         },
+        heading_not_from_wheels: {
+            let causes: Vec<&str> = outcomes
+                .iter()
+                .filter_map(|o| o.synced.heading_not_from_wheels.as_deref())
+                .collect();
+            (!causes.is_empty()).then(|| causes.join("; "))
+        },
     }
 }
 

@@ -54,6 +54,10 @@ pub struct Options {
     /// excited (by default that is an error naming them), at every solve: the
     /// first, the second pass, and each solve of the clock-offset search.
     pub accept_weak: bool,
+    /// Odometry-only mode: the wheel rotations were recovered from odometry poses with
+    /// `initial_params` (the nominal parameters), so the odometry's heading is checked
+    /// to come from the wheels (see [`crate::health::gyro_heading`]).
+    pub odometry_only: bool,
 }
 
 impl Options {
@@ -83,6 +87,7 @@ impl Default for Options {
             second_pass: false,
             icp: IcpParams::default(),
             accept_weak: false,
+            odometry_only: false,
         }
     }
 }

@@ -286,6 +286,7 @@ pub fn synchronize_and_match(
         sweep_compensated,
         read_time_sigma: None,
         unrepaired_timing: None,
+        heading_not_from_wheels: None,
     })
 }
 
@@ -383,7 +384,8 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
 
 /// The calibration, or the refusal naming the parameters it does not determine well,
 /// with their causes and the parameters to hold (unless weak parameters are
-/// accepted). With unrepaired timing in the data no verdict is "well determined".
+/// accepted). With unrepaired timing in the data, or in odometry-only mode a heading
+/// not from the wheels, no verdict is "well determined".
 pub(crate) fn refuse_poorly_determined(
     mut calibration: Calibration,
     synced: &Synchronized,
@@ -391,9 +393,11 @@ pub(crate) fn refuse_poorly_determined(
     solve_options: &SolveOptions,
     opts: &Options,
 ) -> Result<Calibration, PipelineError> {
-    if let Some(cause) = &synced.unrepaired_timing {
-        // Unrepaired timing: the σ do not hold what it does, so no verdict is "well
-        // determined"; the sentence names the cause.
+    let unjudgeable = synced.unjudgeable();
+    let sentence = calibration.observability.sentence.clone();
+    if let Some(cause) = &unjudgeable {
+        // Unrepaired timing, a heading not from the wheels: the σ do not hold what
+        // they do, so no verdict is "well determined"; the sentence names the cause.
         for p in calibration.observability.parameters.iter_mut() {
             if p.verdict == Verdict::WellDetermined && !matches!(p.constraint, Constraint::Held(_))
             {
@@ -413,14 +417,15 @@ pub(crate) fn refuse_poorly_determined(
     if !poor.is_empty() && !solve_options.accept_weak {
         return Err(PipelineError::NotDetermined {
             parameters: poor,
-            sentence: calibration.observability.sentence.clone(),
+            // The cause is named once, among the causes.
+            sentence,
             diagnosis: Box::new(refusal::Diagnosis {
-                causes: match &synced.unrepaired_timing {
+                causes: match &unjudgeable {
                     Some(cause) => vec![cause.clone()],
                     None => refusal::causes(&calibration, synced),
                 },
-                // Holding parameters does not help against unrepaired timing.
-                holds: match synced.unrepaired_timing {
+                // Holding parameters does not help against either.
+                holds: match unjudgeable {
                     Some(_) => Vec::new(),
                     None => refusal::holds(
                         samples,
@@ -534,9 +539,14 @@ pub fn calibrate_log(
     // sweep, on the scans compensated at it (before, the offset and the sweep left
     // rotation residuals that were called slip).
     findings.extend(health::slip::episodes(log, &synced));
+    let heading = odometry_heading(&synced, opts);
+    synced.heading_not_from_wheels = heading.as_ref().map(|fit| fit.cause());
     let t = Instant::now();
     let calibration = solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
     timing.solve += t.elapsed().as_secs_f64();
+    // Named in the findings only when the numbers are shown (--accept-weak): a
+    // refusal names it as its cause.
+    findings.extend(heading.map(|fit| fit.finding()));
 
     let t = Instant::now();
     let samples: Vec<_> = synced
@@ -555,6 +565,20 @@ pub fn calibrate_log(
         timing,
         consistency,
     })
+}
+
+/// In odometry-only mode, the fit of the odometry's rotation when it shows a heading
+/// not from the wheels (see [`health::gyro_heading`]).
+fn odometry_heading(
+    synced: &Synchronized,
+    opts: &Options,
+) -> Option<health::gyro_heading::HeadingFit> {
+    let nominal = opts.initial_params.as_ref().filter(|_| opts.odometry_only)?;
+    let fit = health::gyro_heading::fit_heading(&synced.samples, nominal)?;
+    if std::env::var_os("ODOCAL_DEBUG_HEADING").is_some() {
+        eprintln!("heading fit: {fit:?}");
+    }
+    fit.heading_not_from_wheels().then_some(fit)
 }
 
 /// Time from the first scan to the last (s).

@@ -39,4 +39,20 @@ pub struct Synchronized {
     /// A timing fault nothing repairs (see [`crate::health::scan_jitter`]), in words:
     /// while it is set no parameter is judged well determined.
     pub unrepaired_timing: Option<String>,
+    /// In odometry-only mode, an odometry heading that does not come from the wheels
+    /// (see [`crate::health::gyro_heading`]), in words: while it is set no parameter is
+    /// judged well determined.
+    pub heading_not_from_wheels: Option<String>,
+}
+
+impl Synchronized {
+    /// What keeps every verdict from "well determined" (unrepaired timing, a heading
+    /// not from the wheels), in words; `None` when nothing does.
+    pub fn unjudgeable(&self) -> Option<String> {
+        let causes: Vec<&str> = [&self.unrepaired_timing, &self.heading_not_from_wheels]
+            .into_iter()
+            .filter_map(|c| c.as_deref())
+            .collect();
+        (!causes.is_empty()).then(|| causes.join("; "))
+    }
 }

@@ -10,7 +10,8 @@
 //! times that vary around their timestamps ([`read_jitter`]); timestamps or counts
 //! that cannot be a real robot's are refused ([`plausibility`]). After matching
 //! ([`after_matching`], on the samples): a large laser–encoder clock offset
-//! ([`clock_offset`]) and wheel-slip episodes ([`slip`]).
+//! ([`clock_offset`]) and wheel-slip episodes ([`slip`]); in odometry-only mode, an
+//! odometry heading that does not come from the wheels ([`gyro_heading`]).
 
 pub mod angle_wraps;
 pub mod clock;
@@ -18,6 +19,7 @@ pub mod clock_offset;
 pub mod duplicates;
 pub mod frozen;
 pub mod gaps;
+pub mod gyro_heading;
 pub mod plausibility;
 pub mod read_jitter;
 pub mod scan_jitter;
