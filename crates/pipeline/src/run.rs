@@ -573,12 +573,12 @@ fn odometry_heading(
     synced: &Synchronized,
     opts: &Options,
 ) -> Option<health::gyro_heading::HeadingFit> {
-    let nominal = opts.initial_params.as_ref().filter(|_| opts.odometry_only)?;
-    let fit = health::gyro_heading::fit_heading(&synced.samples, nominal)?;
-    if std::env::var_os("ODOCAL_DEBUG_HEADING").is_some() {
-        eprintln!("heading fit: {fit:?}");
-    }
-    fit.heading_not_from_wheels().then_some(fit)
+    let nominal = opts
+        .initial_params
+        .as_ref()
+        .filter(|_| opts.odometry_only)?;
+    health::gyro_heading::fit_heading(&synced.samples, nominal)
+        .filter(|fit| fit.heading_not_from_wheels())
 }
 
 /// Time from the first scan to the last (s).

@@ -82,8 +82,7 @@ impl HeadingFit {
     /// wheels (a gyro's bias): the heading does not come from the wheels.
     pub fn heading_not_from_wheels(&self) -> bool {
         let precise = self.sigma.iter().all(|s| *s < SIGMA_GATE);
-        let drifts =
-            self.drift.abs() > (DRIFT_SIGMAS * self.drift_sigma).max(MIN_DRIFT);
+        let drifts = self.drift.abs() > (DRIFT_SIGMAS * self.drift_sigma).max(MIN_DRIFT);
         self.chi2 < CHI2_NOMINAL && (precise || drifts)
     }
 
@@ -227,4 +226,149 @@ pub fn fit_heading(samples: &[PairSample], nominal: &Params) -> Option<HeadingFi
         drift_sigma: (var * inv[2][2]).sqrt(),
         samples: kept,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::matching::MatchStats;
+    use crate::sync::{ScanPair, WheelMotion};
+    use odocal_geom::Pose2;
+
+    /// True wheels 0.0331 / 0.0329 m, b 0.1614 m (a TurtleBot's); nominal 0.033, 0.033,
+    /// 0.16.
+    const TRUE: [f64; 3] = [0.0331, 0.0329, 0.1614];
+
+    fn nominal() -> Params {
+        Params::from_vector([0.033, 0.033, 0.16, 0.0, 0.0, 0.0])
+    }
+
+    /// A deterministic uniform number in [-1, 1) per (k, stream).
+    fn noise(k: usize, stream: u64) -> f64 {
+        let mut x = (k as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ stream;
+        x ^= x >> 31;
+        x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        x ^= x >> 29;
+        (x >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    /// `n` pairs of 0.3–0.5 s: straights, arcs, spins both ways and stops, with scan
+    /// matching's rotation noise of `sigma` rad (uniform of that σ). With
+    /// `gyro_bias = Some(β)`, the odometry's heading is a gyro's (the true rotation plus
+    /// β·dt) and its position the wheels' travel with the nominal radii: the wheel
+    /// rotations odometry-only mode recovers carry the gyro's rotation.
+    fn samples(n: usize, sigma: f64, gyro_bias: Option<f64>) -> Vec<PairSample> {
+        let p = nominal();
+        (0..n)
+            .map(|k| {
+                let dt = 0.4 + 0.1 * noise(k, 1);
+                let (l, r) = match k % 6 {
+                    0 | 1 => (2.4, 2.4 + 0.05 * noise(k, 2)),
+                    2 => (1.6, 2.6),
+                    3 => (-1.5, 1.5),
+                    4 => (1.4, -1.4),
+                    _ => (0.0, 0.0),
+                };
+                let (l, r) = (l * dt / 0.4, r * dt / 0.4);
+                let turn = (TRUE[1] * r - TRUE[0] * l) / TRUE[2];
+                let (dphi_l, dphi_r) = match gyro_bias {
+                    None => (l, r),
+                    Some(bias) => {
+                        let sum = l + r;
+                        let diff = p.b * (turn + bias * dt) / p.r_l;
+                        ((sum - diff) / 2.0, (sum + diff) / 2.0)
+                    }
+                };
+                let t0 = k as f64 * 0.5;
+                PairSample {
+                    pair: ScanPair {
+                        first: k,
+                        second: k + 1,
+                        t0,
+                        t1: t0 + dt,
+                    },
+                    wheel: WheelMotion {
+                        t0,
+                        dt,
+                        dphi_l,
+                        dphi_r,
+                        profile: Vec::new(),
+                    },
+                    icp: MatchStats {
+                        pose: Pose2 {
+                            x: 0.0,
+                            y: 0.0,
+                            theta: turn + sigma * 3f64.sqrt() * noise(k, 3),
+                        },
+                        covariance: [[0.0; 3]; 3],
+                        iterations: 1,
+                        correspondences: 100,
+                        mean_residual: 0.0,
+                    },
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn wheel_derived_heading_shows_the_wheels_errors_and_is_not_flagged() {
+        let fit = fit_heading(&samples(150, 8e-4, None), &nominal()).unwrap();
+        // J21 = −r_L/b and J22 = r_R/b of the true wheels against the nominal ones.
+        let expected = [
+            TRUE[0] / TRUE[2] / (0.033 / 0.16) - 1.0,
+            TRUE[1] / TRUE[2] / (0.033 / 0.16) - 1.0,
+        ];
+        for i in 0..2 {
+            assert!(
+                (fit.deviation[i] - expected[i]).abs() < 4.0 * fit.sigma[i],
+                "{fit:?}"
+            );
+        }
+        assert!(fit.chi2 > 100.0, "{fit:?}");
+        assert!(fit.drift.abs() < 4.0 * fit.drift_sigma, "{fit:?}");
+        assert!(!fit.heading_not_from_wheels(), "{fit:?}");
+    }
+
+    #[test]
+    fn gyro_heading_is_flagged_with_or_without_a_bias() {
+        for bias in [0.0, 0.005, -0.002] {
+            let fit = fit_heading(&samples(150, 8e-4, Some(bias)), &nominal()).unwrap();
+            assert!(fit.chi2 < CHI2_NOMINAL, "bias {bias}: {fit:?}");
+            assert!(fit.sigma.iter().all(|s| *s < SIGMA_GATE), "{fit:?}");
+            assert!(fit.heading_not_from_wheels(), "bias {bias}: {fit:?}");
+            // The bias is the rotation the wheels do not explain, with the sign that
+            // scan matching sees it: the odometry turned by it, the scans did not.
+            assert!((fit.drift + bias).abs() < 4.0 * fit.drift_sigma, "{fit:?}");
+            assert!(fit.cause().starts_with(CAUSE));
+        }
+    }
+
+    #[test]
+    fn a_log_too_noisy_to_tell_is_not_judged() {
+        // 30 pairs with 10 mrad of matching noise: σ of the Jacobian terms above the gate,
+        // and no bias to show.
+        let fit = fit_heading(&samples(30, 1e-2, Some(0.0)), &nominal()).unwrap();
+        assert!(fit.sigma.iter().any(|s| *s >= SIGMA_GATE), "{fit:?}");
+        assert!(!fit.heading_not_from_wheels(), "{fit:?}");
+        assert!(fit_heading(&samples(MIN_SAMPLES - 1, 8e-4, None), &nominal()).is_none());
+    }
+
+    #[test]
+    fn the_three_by_three_solve_inverts() {
+        let a = [[4.0, 1.0, 0.5], [1.0, 3.0, 0.2], [0.5, 0.2, 2.0]];
+        let (x, inv) = solve3(&a, &[1.0, 2.0, 3.0]).unwrap();
+        for i in 0..3 {
+            let back: f64 = (0..3).map(|j| a[i][j] * x[j]).sum();
+            assert!((back - [1.0, 2.0, 3.0][i]).abs() < 1e-12);
+            for j in 0..3 {
+                let e: f64 = (0..3).map(|m| a[i][m] * inv[m][j]).sum();
+                assert!((e - f64::from(u8::from(i == j))).abs() < 1e-12);
+            }
+        }
+        assert!(solve3(
+            &[[1.0, 2.0, 3.0], [2.0, 4.0, 6.0], [0.0, 0.0, 1.0]],
+            &[0.0; 3]
+        )
+        .is_none());
+    }
 }
