@@ -397,15 +397,21 @@ pub(crate) fn refuse_poorly_determined(
     let sentence = calibration.observability.sentence.clone();
     if let Some(cause) = &unjudgeable {
         // Unrepaired timing, a heading not from the wheels: the σ do not hold what
-        // they do, so no verdict is "well determined"; the sentence names the cause.
+        // they do, so no verdict is "well determined"; the sentence names the cause
+        // (the heading's in short: its finding has the evidence and the way out).
         for p in calibration.observability.parameters.iter_mut() {
             if p.verdict == Verdict::WellDetermined && !matches!(p.constraint, Constraint::Held(_))
             {
                 p.verdict = Verdict::Weak;
             }
         }
+        let short = match (&synced.unrepaired_timing, &synced.heading_not_from_wheels) {
+            (Some(timing), Some(_)) => format!("{timing}; {}", health::gyro_heading::CAUSE),
+            (None, Some(_)) => health::gyro_heading::CAUSE.to_string(),
+            _ => cause.clone(),
+        };
         calibration.observability.sentence =
-            format!("{}; {cause}", calibration.observability.sentence);
+            format!("{}; {short}", calibration.observability.sentence);
     }
     let poor: Vec<String> = calibration
         .observability
