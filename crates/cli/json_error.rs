@@ -34,9 +34,13 @@ pub fn error_object(error: &anyhow::Error, args: &[String]) -> Value {
     };
     let message = format!("{error:#}");
     let mut object = json!({ "error": message, "kind": kind });
-    if let Some(command) = heading.and_then(|h| h.command.as_ref()) {
-        // A gyro-heading refusal: calibrate from the bag's wheel joint states.
-        object["suggested_command"] = command.clone().into();
+    if let Some(h) = heading {
+        // A gyro-heading refusal: calibrate from the bag's wheel joint states when it
+        // has them; else no command (the message says how to record wheel-only
+        // odometry; --accept-weak would only show numbers known to be wrong).
+        if let Some(command) = &h.command {
+            object["suggested_command"] = command.clone().into();
+        }
     } else if let Some(h) = hold {
         // The refusal's own command: the parameters to hold (MEASURED to fill in).
         object["suggested_command"] = h.command.clone().into();
@@ -63,5 +67,46 @@ fn suggested_flag(error: Option<&PipelineError>, message: &str) -> Option<&'stat
         Some("--nominal r_L,r_R,b")
     } else {
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use odocal_pipeline::health::gyro_heading::CAUSE;
+
+    fn heading_refusal(command: Option<&str>) -> anyhow::Error {
+        HeadingRefusal {
+            refusal: PipelineError::NotDetermined {
+                parameters: vec!["b".into()],
+                sentence: "all six parameters are well determined".into(),
+                diagnosis: Box::new(odocal_pipeline::refusal::Diagnosis {
+                    causes: vec![CAUSE.into()],
+                    ..Default::default()
+                }),
+            },
+            imu: Vec::new(),
+            command: command.map(String::from),
+        }
+        .into()
+    }
+
+    #[test]
+    fn a_gyro_heading_refusal_suggests_the_joint_states_or_nothing() {
+        let args = ["odocal".to_string(), "calibrate".into()];
+        let v = error_object(
+            &heading_refusal(Some("odocal calibrate X --joint-states-topic /j")),
+            &args,
+        );
+        assert_eq!(v["kind"], "not_determined");
+        assert_eq!(
+            v["suggested_command"],
+            "odocal calibrate X --joint-states-topic /j"
+        );
+        assert!(v["error"].as_str().unwrap().contains(CAUSE));
+        // Without joint states: no --accept-weak for numbers known to be wrong.
+        let v = error_object(&heading_refusal(None), &args);
+        assert_eq!(v["kind"], "not_determined");
+        assert!(v.get("suggested_command").is_none(), "{v}");
     }
 }
