@@ -181,3 +181,42 @@ fn calibrate_skips_a_malformed_scan_and_says_so() {
     );
     std::fs::remove_file(path).unwrap();
 }
+
+#[test]
+fn info_findings_on_a_bag_name_the_topic_message_and_stamp() {
+    // turtlebot_tf.bag records one /joint_states message twice. Before: "1 ENCODER
+    // record(s) repeat … first at line 302" — a bag has no lines, and its user looks
+    // for a topic, a message and a stamp.
+    for (flags, clock) in [
+        (&[][..], "header stamp 1190000"),
+        (&["--use-receive-time"][..], "receive time 1190000"),
+    ] {
+        let mut args = vec!["info", "fixtures/bags/turtlebot_tf.bag"];
+        args.extend_from_slice(flags);
+        let out = odocal(&args);
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let finding = text
+            .lines()
+            .find(|l| l.contains("[duplicate]"))
+            .unwrap_or_else(|| panic!("no duplicate finding: {text}"));
+        assert!(
+            finding.contains("/joint_states messages repeat an earlier one")
+                && finding.contains("first at /joint_states message ")
+                && finding.contains(clock),
+            "{finding}"
+        );
+        for carmen_word in ["line ", "ENCODER", "record(s)"] {
+            assert!(
+                !finding.contains(carmen_word),
+                "{carmen_word:?} in {finding}"
+            );
+        }
+        // A LaserScan has no Carmen laser type.
+        assert!(!text.contains("laser type"), "{text}");
+    }
+}

@@ -209,7 +209,7 @@ fn print_bag_summary(s: &LogSummary) -> anyhow::Result<()> {
         _ => outln!("stamps:           none"),
     }?;
     for g in &s.geometries {
-        outln!("scan geometry:    {g}")?;
+        outln!("scan geometry:    {}: {} scans", g.rays_text(), g.scans)?;
     }
     let hz = |r: Option<f64>| r.map_or("n/a".to_string(), |r| format!("{r:.2} Hz"));
     outln!("scan rate:        {}", hz(s.scan_rate_hz))?;

@@ -38,18 +38,28 @@ impl GeometrySummary {
     }
 }
 
-impl fmt::Display for GeometrySummary {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{} rays from {:.6} rad every {:.8} rad (fov {:.6} rad), range ({}, {}) m, \
-             laser type {}: {} scans",
+impl GeometrySummary {
+    /// The rays in words (count, angles, range), without the Carmen laser type: what
+    /// a `sensor_msgs/LaserScan` says of them.
+    pub fn rays_text(&self) -> String {
+        format!(
+            "{} rays from {:.6} rad every {:.8} rad (fov {:.6} rad), range ({}, {}) m",
             self.rays,
             self.start_angle,
             self.resolution,
             self.fov,
             sensor_value(self.min_range),
             self.max_range.map_or("∞".to_string(), sensor_value),
+        )
+    }
+}
+
+impl fmt::Display for GeometrySummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}, laser type {}: {} scans",
+            self.rays_text(),
             self.laser_type,
             self.scans
         )
