@@ -400,8 +400,10 @@ pub(crate) fn refuse_poorly_determined(
                 p.verdict = Verdict::Weak;
             }
         }
-        calibration.observability.sentence =
-            format!("{}; {cause}", calibration.observability.sentence);
+        calibration.observability.sentence = format!(
+            "{cause}; with its own acquisition times the motion would give: {}",
+            calibration.observability.sentence
+        );
     }
     let poor: Vec<String> = calibration
         .observability
@@ -411,9 +413,20 @@ pub(crate) fn refuse_poorly_determined(
         .map(|p| p.name.clone())
         .collect();
     if !poor.is_empty() && !solve_options.accept_weak {
+        // With unrepaired timing the cause leads the refusal; the sentence says what
+        // the motion alone would give.
+        let sentence = match &synced.unrepaired_timing {
+            Some(cause) => calibration
+                .observability
+                .sentence
+                .trim_start_matches(cause.as_str())
+                .trim_start_matches("; ")
+                .to_string(),
+            None => calibration.observability.sentence.clone(),
+        };
         return Err(PipelineError::NotDetermined {
             parameters: poor,
-            sentence: calibration.observability.sentence.clone(),
+            sentence,
             diagnosis: Box::new(refusal::Diagnosis {
                 causes: match &synced.unrepaired_timing {
                     Some(cause) => vec![cause.clone()],
