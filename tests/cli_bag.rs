@@ -220,3 +220,20 @@ fn info_findings_on_a_bag_name_the_topic_message_and_stamp() {
         assert!(!text.contains("laser type"), "{text}");
     }
 }
+
+#[test]
+fn the_calibration_summary_of_a_bag_counts_messages_not_encoder_records() {
+    // Before: "200 scans, 1001 encoder records" for a bag's joint states.
+    let out = odocal(&["calibrate", "fixtures/bags/khepera_ros1_lz4.bag"]);
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("200 scans, 1001 /joint_states messages"),
+        "{text}"
+    );
+    assert!(!text.contains("encoder records"), "{text}");
+}

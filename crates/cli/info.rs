@@ -215,6 +215,8 @@ fn print_bag_summary(s: &LogSummary) -> anyhow::Result<()> {
     outln!("scan rate:        {}", hz(s.scan_rate_hz))?;
     if s.encoder_records > 0 {
         outln!("joint-state rate: {}", hz(s.encoder_rate_hz))?;
+    } else if s.odom_records > 0 {
+        outln!("odometry rate:    {}", hz(s.odom_rate_hz))?;
     }
     outln!(
         "invalid ranges:   {} ({:.2}%)",
