@@ -237,3 +237,34 @@ fn the_calibration_summary_of_a_bag_counts_messages_not_encoder_records() {
     );
     assert!(!text.contains("encoder records"), "{text}");
 }
+
+#[test]
+fn the_nominal_laser_pose_comes_from_robot_description_when_tf_static_lacks_it() {
+    // urdf_only.bag: /tf_static has base_footprint -> base_link only; the URDF in
+    // robot_description has base_link -> laser_mount (x 0.1 m, z 0.05 m, yaw π/2) ->
+    // base_scan (x 0.02 m), so the laser is at (0.1, 0.02) m, yaw π/2 in base_link.
+    // Before: no nominal_laser (the URDF was not read).
+    let out = odocal(&["info", "fixtures/bags/urdf_only.bag", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let l = &v["nominal_laser"];
+    assert_eq!(l["source"], "robot_description", "{l}");
+    assert_eq!(l["base_frame"], "base_link", "{l}");
+    assert_eq!(l["laser_frame"], "base_scan", "{l}");
+    let near = |key: &str, expected: f64| {
+        let x = l[key].as_f64().unwrap_or(f64::NAN);
+        assert!((x - expected).abs() < 1e-9, "{key}: {x} vs {expected}");
+    };
+    near("x", 0.1);
+    near("y", 0.02);
+    near("theta", std::f64::consts::FRAC_PI_2);
+    near("z", 0.05);
+    // Where the bag has both, the transforms the robot published win.
+    let out = odocal(&["info", "fixtures/bags/turtlebot_tf.bag", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["nominal_laser"]["source"], "/tf_static");
+}

@@ -145,8 +145,9 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
     }
     if let Some(l) = &info.nominal_laser {
         outln!(
-            "nominal laser pose (static transforms {} -> {}): l_x = {:.4} m, l_y = {:.4} m, \
+            "nominal laser pose ({} {} -> {}): l_x = {:.4} m, l_y = {:.4} m, \
              l_theta = {:.4} rad ({:.2}°), height {:.3} m",
+            l.source,
             l.base_frame,
             l.laser_frame,
             l.x,
