@@ -181,3 +181,90 @@ fn calibrate_skips_a_malformed_scan_and_says_so() {
     );
     std::fs::remove_file(path).unwrap();
 }
+
+#[test]
+fn info_findings_on_a_bag_name_the_topic_message_and_stamp() {
+    // turtlebot_tf.bag records one /joint_states message twice. Before: "1 ENCODER
+    // record(s) repeat … first at line 302" — a bag has no lines, and its user looks
+    // for a topic, a message and a stamp.
+    for (flags, clock) in [
+        (&[][..], "header stamp 1190000"),
+        (&["--use-receive-time"][..], "receive time 1190000"),
+    ] {
+        let mut args = vec!["info", "fixtures/bags/turtlebot_tf.bag"];
+        args.extend_from_slice(flags);
+        let out = odocal(&args);
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let finding = text
+            .lines()
+            .find(|l| l.contains("[duplicate]"))
+            .unwrap_or_else(|| panic!("no duplicate finding: {text}"));
+        assert!(
+            finding.contains("/joint_states messages repeat an earlier one")
+                && finding.contains("first at /joint_states message ")
+                && finding.contains(clock),
+            "{finding}"
+        );
+        for carmen_word in ["line ", "ENCODER", "record(s)"] {
+            assert!(
+                !finding.contains(carmen_word),
+                "{carmen_word:?} in {finding}"
+            );
+        }
+        // A LaserScan has no Carmen laser type.
+        assert!(!text.contains("laser type"), "{text}");
+    }
+}
+
+#[test]
+fn the_calibration_summary_of_a_bag_counts_messages_not_encoder_records() {
+    // Before: "200 scans, 1001 encoder records" for a bag's joint states.
+    let out = odocal(&["calibrate", "fixtures/bags/khepera_ros1_lz4.bag"]);
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("200 scans, 1001 /joint_states messages"),
+        "{text}"
+    );
+    assert!(!text.contains("encoder records"), "{text}");
+}
+
+#[test]
+fn the_nominal_laser_pose_comes_from_robot_description_when_tf_static_lacks_it() {
+    // urdf_only.bag: /tf_static has base_footprint -> base_link only; the URDF in
+    // robot_description has base_link -> laser_mount (x 0.1 m, z 0.05 m, yaw π/2) ->
+    // base_scan (x 0.02 m), so the laser is at (0.1, 0.02) m, yaw π/2 in base_link.
+    // Before: no nominal_laser (the URDF was not read).
+    let out = odocal(&["info", "fixtures/bags/urdf_only.bag", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let l = &v["nominal_laser"];
+    assert_eq!(l["source"], "robot_description", "{l}");
+    assert_eq!(l["base_frame"], "base_link", "{l}");
+    assert_eq!(l["laser_frame"], "base_scan", "{l}");
+    let near = |key: &str, expected: f64| {
+        let x = l[key].as_f64().unwrap_or(f64::NAN);
+        assert!((x - expected).abs() < 1e-9, "{key}: {x} vs {expected}");
+    };
+    near("x", 0.1);
+    near("y", 0.02);
+    near("theta", std::f64::consts::FRAC_PI_2);
+    near("z", 0.05);
+    // Where the bag has both, the transforms the robot published win.
+    let out = odocal(&["info", "fixtures/bags/turtlebot_tf.bag", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["nominal_laser"]["source"], "/tf_static");
+}

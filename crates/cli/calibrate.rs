@@ -202,7 +202,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     report.timing_s.parse = parse_s;
     report.odometry_only = odometry_only.is_some();
     report.nominal_laser = laser.map(|l| NominalLaserPose {
-        source: "/tf_static".into(),
+        source: l.source,
         base_frame: l.base_frame,
         laser_frame: l.laser_frame,
         l_x: l.x,

@@ -145,8 +145,9 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
     }
     if let Some(l) = &info.nominal_laser {
         outln!(
-            "nominal laser pose (static transforms {} -> {}): l_x = {:.4} m, l_y = {:.4} m, \
+            "nominal laser pose ({} {} -> {}): l_x = {:.4} m, l_y = {:.4} m, \
              l_theta = {:.4} rad ({:.2}°), height {:.3} m",
+            l.source,
             l.base_frame,
             l.laser_frame,
             l.x,
@@ -209,12 +210,14 @@ fn print_bag_summary(s: &LogSummary) -> anyhow::Result<()> {
         _ => outln!("stamps:           none"),
     }?;
     for g in &s.geometries {
-        outln!("scan geometry:    {g}")?;
+        outln!("scan geometry:    {}: {} scans", g.rays_text(), g.scans)?;
     }
     let hz = |r: Option<f64>| r.map_or("n/a".to_string(), |r| format!("{r:.2} Hz"));
     outln!("scan rate:        {}", hz(s.scan_rate_hz))?;
     if s.encoder_records > 0 {
         outln!("joint-state rate: {}", hz(s.encoder_rate_hz))?;
+    } else if s.odom_records > 0 {
+        outln!("odometry rate:    {}", hz(s.odom_rate_hz))?;
     }
     outln!(
         "invalid ranges:   {} ({:.2}%)",

@@ -90,8 +90,9 @@ impl InputArgs {
         {
             *p = Params::from_vector([p.r_l, p.r_r, p.b, l.x, l.y, l.theta]);
             errln!(
-                "nominal laser pose from the bag's static transforms ({} -> {}): \
+                "nominal laser pose from the bag's {} ({} -> {}): \
                  l_x = {:.4} m, l_y = {:.4} m, l_theta = {:.4} rad",
+                l.source,
                 l.base_frame,
                 l.laser_frame,
                 l.x,

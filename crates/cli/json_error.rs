@@ -44,6 +44,17 @@ pub fn error_object(error: &anyhow::Error, args: &[String]) -> Value {
     } else if let Some(h) = hold {
         // The refusal's own command: the parameters to hold (MEASURED to fill in).
         object["suggested_command"] = h.command.clone().into();
+    } else if message.contains("leave out --use-receive-time")
+        && args.iter().any(|a| a == "--use-receive-time")
+    {
+        // Timing read from when the bag recorded the messages: the way out is the
+        // header stamps, not weak numbers.
+        let command: Vec<&str> = args
+            .iter()
+            .map(String::as_str)
+            .filter(|a| *a != "--use-receive-time")
+            .collect();
+        object["suggested_command"] = command.join(" ").into();
     } else if let Some(flag) = suggested_flag(pipeline, &message) {
         let mut command: Vec<&str> = args.iter().map(String::as_str).collect();
         command.push(flag);

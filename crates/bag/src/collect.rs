@@ -5,11 +5,11 @@
 use crate::error::{seconds, BagError};
 use crate::limits::MAX_DECODED_BYTES;
 use crate::messages::{
-    decode_joint_state, decode_laser_scan, decode_odometry, header_frame, MessageKind, OdometryMsg,
-    ScanFields,
+    decode_joint_state, decode_laser_scan, decode_odometry, header_frame, normalize_type,
+    MessageKind, OdometryMsg, ScanFields,
 };
 use crate::tf::{decode_tf_message, TfTree};
-use crate::wire::Encoding;
+use crate::wire::{Encoding, Wire};
 use crate::zstd_input::decompress_message;
 use std::collections::HashMap;
 
@@ -161,6 +161,9 @@ pub struct Collected {
     pub(crate) odom: HashMap<usize, Vec<(OdometryMsg, u64)>>,
     /// The static transforms of `/tf_static` and `/tf`.
     pub tf: TfTree,
+    /// The fixed joints of the robot description (`robot_description`), for the
+    /// edges the transform messages lack.
+    pub described: Vec<crate::tf::Transform>,
     filter: DecodeFilter,
     /// Files read, in order.
     pub files: Vec<String>,
@@ -221,6 +224,7 @@ impl Collected {
         };
         let skipped = kind == MessageKind::JointState && self.filter.odometry_only;
         let decode = kind == MessageKind::Transforms
+            || is_robot_description(name, type_name)
             || (kind != MessageKind::Other
                 && !skipped
                 && wanted.as_deref().is_none_or(|w| w == name));
@@ -372,7 +376,21 @@ impl Collected {
                 }
                 n * 128
             }
-            MessageKind::Other => 0,
+            MessageKind::Other => {
+                // Only a robot description is decoded among the other types.
+                let xml = Wire::new(body, encoding)
+                    .and_then(|mut w| w.string("data"))
+                    .map_err(|e| format!("message {index} cannot be decoded: {e}"));
+                match xml.and_then(crate::urdf::fixed_joints) {
+                    Ok(joints) => self.described = joints,
+                    Err(why) => self.warnings.push(format!(
+                        "topic {}: {why}; the nominal laser pose is taken from the \
+                         static transforms only",
+                        t.name
+                    )),
+                }
+                0
+            }
         };
         self.decoded_bytes += kept as u64;
         if self.decoded_bytes > MAX_DECODED_BYTES {
@@ -393,4 +411,11 @@ impl Collected {
         }
         Ok(())
     }
+}
+
+/// True for a robot description topic: a `std_msgs/String` named `robot_description`
+/// (in any namespace), the URDF `robot_state_publisher` latches.
+fn is_robot_description(topic: &str, type_name: &str) -> bool {
+    normalize_type(type_name) == "std_msgs/String"
+        && (topic == "robot_description" || topic.ends_with("/robot_description"))
 }

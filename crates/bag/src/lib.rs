@@ -30,6 +30,7 @@ mod select;
 mod sqlite_source;
 pub mod tf;
 mod to_log;
+pub mod urdf;
 mod wire;
 mod zstd_input;
 
@@ -159,7 +160,9 @@ fn nominal_laser(c: &Collected, scan_topic: &str) -> Option<NominalLaser> {
         .topic_index(scan_topic)
         .and_then(|i| c.scans.get(&i))
         .and_then(|s| s.frame_id.as_deref())?;
-    c.tf.nominal_laser(frame)
+    let mut tree = c.tf.clone();
+    tree.add_described(c.described.clone());
+    tree.nominal_laser(frame)
 }
 
 /// The laser geometry of a scan topic as its first message declares it.

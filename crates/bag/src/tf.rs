@@ -1,5 +1,6 @@
 //! The robot's static transforms (`tf2_msgs/TFMessage` on `/tf_static`, and on `/tf`
-//! those that never change), and the nominal laser pose they give: the transform from
+//! those that never change; the fixed joints of `robot_description` for the edges
+//! these lack), and the nominal laser pose they give: the transform from
 //! the base frame (`base_link`, else `base_footprint`, else the root of the tree) to
 //! the scan's `frame_id`, projected on the plane (x, y, yaw).
 
@@ -59,6 +60,8 @@ fn strip_slash(frame: &str) -> &str {
 struct Edge {
     transform: Transform,
     varies: bool,
+    /// From the robot description (URDF), not from a transform message.
+    described: bool,
 }
 
 /// The static part of a bag's transform tree, child frame → edge.
@@ -95,8 +98,33 @@ impl TfTree {
             Edge {
                 transform: t,
                 varies: false,
+                described: false,
             },
         );
+    }
+
+    /// Adds the fixed joints of the robot description for the frames no transform
+    /// message gave (the messages are what the robot published: they win).
+    pub(crate) fn add_described(&mut self, joints: Vec<Transform>) {
+        for mut t in joints {
+            t.parent = strip_slash(&t.parent).to_string();
+            t.child = strip_slash(&t.child).to_string();
+            if self.edges.contains_key(&t.child) {
+                continue;
+            }
+            if self.edges.len() >= MAX_FRAMES {
+                self.dropped += 1;
+                continue;
+            }
+            self.edges.insert(
+                t.child.clone(),
+                Edge {
+                    transform: t,
+                    varies: false,
+                    described: true,
+                },
+            );
+        }
     }
 
     /// The nominal pose of `laser_frame` in the base frame, when the static tree
@@ -105,12 +133,14 @@ impl TfTree {
         let laser_frame = strip_slash(laser_frame);
         // The chain laser → … → root through edges that never moved.
         let mut chain: Vec<&Transform> = Vec::new();
+        let mut described: Vec<bool> = Vec::new();
         let mut frame = laser_frame;
         while let Some(e) = self.edges.get(frame).filter(|e| !e.varies) {
             if chain.len() > self.edges.len() {
                 return None; // a cycle
             }
             chain.push(&e.transform);
+            described.push(e.described);
             frame = &e.transform.parent;
         }
         let parents: Vec<&str> = chain.iter().map(|t| t.parent.as_str()).collect();
@@ -119,6 +149,14 @@ impl TfTree {
             .find_map(|b| parents.iter().position(|p| p == b))
             .or_else(|| chain.len().checked_sub(1))?;
         let base_frame = parents[base_at].to_string();
+        let source = match (
+            described[..=base_at].iter().any(|d| *d),
+            described[..=base_at].iter().all(|d| *d),
+        ) {
+            (false, _) => "/tf_static",
+            (true, true) => "robot_description",
+            (true, false) => "/tf_static and robot_description",
+        };
         // Compose base → … → laser: the chain's edges from the base down.
         let (mut t, mut q) = ([0.0; 3], [0.0, 0.0, 0.0, 1.0]);
         for edge in chain[..=base_at].iter().rev() {
@@ -131,6 +169,7 @@ impl TfTree {
         // Roll and pitch beyond a degree make the planar pose misleading.
         let tilt = (2.0 * (x * x + y * y)).min(1.0).asin();
         Some(NominalLaser {
+            source: source.to_string(),
             base_frame,
             laser_frame: laser_frame.to_string(),
             x: t[0],
@@ -145,6 +184,9 @@ impl TfTree {
 /// The laser's pose in the base frame as the bag's static transforms give it.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct NominalLaser {
+    /// Where the transforms came from: `/tf_static` (the static transform messages),
+    /// `robot_description` (the URDF's fixed joints), or both.
+    pub source: String,
     /// The base frame the pose is relative to.
     pub base_frame: String,
     /// The scan's frame.

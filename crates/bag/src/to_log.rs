@@ -7,8 +7,8 @@ use crate::error::{self, BagError};
 use crate::scan_check::scan_problem;
 use crate::select::{Selection, WheelSource};
 use odocal_log::{
-    ticks_of_angle, EncoderRecord, LaserFields, Log, OdomRecord, ReadOptions, ScanGeometry,
-    ScanKind, ValueSource, WHEEL_TICKS_PER_REVOLUTION,
+    ticks_of_angle, BagClock, EncoderRecord, LaserFields, Log, OdomRecord, Origin, ReadOptions,
+    ScanGeometry, ScanKind, ValueSource, WHEEL_TICKS_PER_REVOLUTION,
 };
 use std::collections::BTreeMap;
 
@@ -79,6 +79,18 @@ pub(crate) fn build_log(
 ) -> Result<Log, BagError> {
     let mut log = Log::default();
     log.stats.source = file.to_string();
+    log.stats.origin = Origin::Bag {
+        scan_topic: sel.scan_topic.clone(),
+        wheel_topic: match &sel.wheels {
+            WheelSource::JointStates { topic, .. } | WheelSource::Odometry { topic } => {
+                topic.clone()
+            }
+        },
+        clock: match clock {
+            Clock::Header => BagClock::HeaderStamp,
+            Clock::Receive => BagClock::ReceiveTime,
+        },
+    };
     let mut messages = BTreeMap::new();
 
     // Scans.

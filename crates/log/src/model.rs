@@ -469,6 +469,8 @@ impl ScanStore {
 pub struct ReadStats {
     /// The file (or stream name) the log was read from.
     pub source: String,
+    /// What kind of source it was (text log or bag): how messages point into it.
+    pub origin: crate::Origin,
     /// Total lines read.
     pub lines: u64,
     /// Comment lines (`#`).

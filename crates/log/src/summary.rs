@@ -38,18 +38,28 @@ impl GeometrySummary {
     }
 }
 
-impl fmt::Display for GeometrySummary {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "{} rays from {:.6} rad every {:.8} rad (fov {:.6} rad), range ({}, {}) m, \
-             laser type {}: {} scans",
+impl GeometrySummary {
+    /// The rays in words (count, angles, range), without the Carmen laser type: what
+    /// a `sensor_msgs/LaserScan` says of them.
+    pub fn rays_text(&self) -> String {
+        format!(
+            "{} rays from {:.6} rad every {:.8} rad (fov {:.6} rad), range ({}, {}) m",
             self.rays,
             self.start_angle,
             self.resolution,
             self.fov,
             sensor_value(self.min_range),
             self.max_range.map_or("∞".to_string(), sensor_value),
+        )
+    }
+}
+
+impl fmt::Display for GeometrySummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}, laser type {}: {} scans",
+            self.rays_text(),
             self.laser_type,
             self.scans
         )
@@ -116,6 +126,8 @@ pub struct LogSummary {
     pub scan_rate_hz: Option<f64>,
     /// Encoder records per second over the encoder stream's span.
     pub encoder_rate_hz: Option<f64>,
+    /// Odometry (`ODOM`) records per second over their span.
+    pub odom_rate_hz: Option<f64>,
     /// Encoder ticks per wheel revolution, when known.
     pub ticks_per_revolution: Option<f64>,
     /// Where it came from.
@@ -222,6 +234,7 @@ impl LogSummary {
             geometries,
             scan_rate_hz: rate(scans.len(), scan_span.0, scan_span.1),
             encoder_rate_hz: rate(log.encoders.len(), enc_span.0, enc_span.1),
+            odom_rate_hz: rate(log.odom.len(), odom_span.0, odom_span.1),
             ticks_per_revolution: log.params.ticks_per_revolution.as_ref().map(|p| p.0),
             ticks_per_revolution_source: log
                 .params
@@ -296,17 +309,27 @@ impl fmt::Display for LogSummary {
         }
         let hz = |r: Option<f64>| r.map_or("n/a".to_string(), |r| format!("{r:.2} Hz"));
         writeln!(f, "scan rate:      {}", hz(self.scan_rate_hz))?;
-        writeln!(f, "encoder rate:   {}", hz(self.encoder_rate_hz))?;
-        match (
-            &self.ticks_per_revolution,
-            &self.ticks_per_revolution_source,
-        ) {
-            (Some(t), Some(src)) => writeln!(f, "ticks/rev:      {t} ({src})")?,
-            _ => writeln!(
+        if self.encoder_records == 0 && self.odom_records > 0 {
+            // Odometry-only data: no encoder counts, so no ticks per revolution.
+            writeln!(f, "odometry rate:  {}", hz(self.odom_rate_hz))?;
+            writeln!(
                 f,
-                "ticks/rev:      unknown (pass --ticks-per-rev X or add \
-                 `PARAM robot_wheel_ticks_per_revolution X`)"
-            )?,
+                "wheels:         odometry only (ODOM poses, no ENCODER records): calibrate \
+                 recovers the wheel rotations with --nominal r_L,r_R,b"
+            )?;
+        } else {
+            writeln!(f, "encoder rate:   {}", hz(self.encoder_rate_hz))?;
+            match (
+                &self.ticks_per_revolution,
+                &self.ticks_per_revolution_source,
+            ) {
+                (Some(t), Some(src)) => writeln!(f, "ticks/rev:      {t} ({src})")?,
+                _ => writeln!(
+                    f,
+                    "ticks/rev:      unknown (pass --ticks-per-rev X or add \
+                     `PARAM robot_wheel_ticks_per_revolution X`)"
+                )?,
+            }
         }
         if let Some(m) = self.encoder_modulus {
             writeln!(f, "encoder wraps:  {} (modulus {m})", self.encoder_wraps)?;
@@ -331,6 +354,30 @@ impl fmt::Display for LogSummary {
 mod tests {
     use super::*;
     use crate::{read_carmen_from, ReadOptions};
+
+    #[test]
+    fn odometry_only_data_speak_of_odometry_not_ticks() {
+        // Before: "encoder rate: n/a" and "ticks/rev: unknown (pass --ticks-per-rev X …)",
+        // advice that cannot help a log without encoder counts.
+        let mut text = String::new();
+        for i in 0..=50 {
+            let t = 100.0 + i as f64 * 0.02;
+            text.push_str(&format!(
+                "ODOM {} 0 0 0.1 0 0 {t} h {t}\n",
+                i as f64 * 0.002
+            ));
+        }
+        let log =
+            read_carmen_from(text.as_bytes(), "odom.log", &ReadOptions::default()).expect("reads");
+        let s = LogSummary::of(&log);
+        assert!((s.odom_rate_hz.unwrap() - 50.0).abs() < 1e-6, "{s:?}");
+        let shown = s.to_string();
+        assert!(shown.contains("odometry rate:  50.00 Hz"), "{shown}");
+        assert!(shown.contains("--nominal r_L,r_R,b"), "{shown}");
+        for word in ["ticks/rev", "encoder rate", "--ticks-per-rev"] {
+            assert!(!shown.contains(word), "{word:?} in {shown}");
+        }
+    }
 
     #[test]
     fn summary_counts_rates_and_sources() {

@@ -84,14 +84,20 @@ impl PipelineError {
         let Some(faults) = crate::finding::explain(findings).filter(|_| refusal) else {
             return self;
         };
-        // The trajectory or the matching explains it: the faults are only also found.
+        // The trajectory or the matching explains it: the faults are only also found
+        // (those that are not the cause itself).
         let refused = match self {
             PipelineError::NotDetermined {
                 parameters,
                 sentence,
                 mut diagnosis,
             } if !diagnosis.causes.is_empty() => {
-                diagnosis.faults = Some(faults);
+                let others: Vec<crate::finding::Finding> = findings
+                    .iter()
+                    .filter(|f| !diagnosis.causes.contains(&f.message))
+                    .cloned()
+                    .collect();
+                diagnosis.faults = crate::finding::explain(&others);
                 return PipelineError::NotDetermined {
                     parameters,
                     sentence,

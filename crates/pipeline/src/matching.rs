@@ -53,6 +53,22 @@ pub fn typical_noise_sigma(scans: &ScanStore, params: &IcpParams) -> f64 {
     *noise.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
+/// Where a scan is in its source, for a message: its line in a text log; in a bag, its
+/// message number on the scan topic and its stamp (the store does not know the topic:
+/// [`odocal_log::Origin::at`] names it where the log is at hand).
+fn scan_place(s: &odocal_log::ScanRef<'_>) -> String {
+    match s.kind {
+        odocal_log::ScanKind::LaserScan => {
+            format!(
+                "LaserScan message {}, stamp {:.3} s",
+                s.line.saturating_sub(1),
+                s.t
+            )
+        }
+        _ => format!("line {}", s.line),
+    }
+}
+
 /// Matches the pairs `(first, second)` of scan indices, each with its first guess,
 /// in parallel (rayon's current pool). Results come back in pair order and do not
 /// depend on the number of threads. `done` is called once per pair (progress).
@@ -84,7 +100,7 @@ pub fn match_pairs(
         .map_err(|e| {
             MatchFailure::new(
                 Rejection::of(&e),
-                format!("scan {i} (line {}): {e}", s.line),
+                format!("scan {i} ({}): {e}", scan_place(&s)),
             )
         }),
         None => Err(MatchFailure::new(

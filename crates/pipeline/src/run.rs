@@ -410,8 +410,7 @@ pub(crate) fn refuse_poorly_determined(
             (None, Some(_)) => health::gyro_heading::CAUSE.to_string(),
             _ => cause.clone(),
         };
-        calibration.observability.sentence =
-            format!("{}; {short}", calibration.observability.sentence);
+        calibration.observability.sentence = format!("{short}; {}", would_give(synced, &sentence));
     }
     let poor: Vec<String> = calibration
         .observability
@@ -421,9 +420,14 @@ pub(crate) fn refuse_poorly_determined(
         .map(|p| p.name.clone())
         .collect();
     if !poor.is_empty() && !solve_options.accept_weak {
+        // The cause is named once, among the causes; the sentence says what the
+        // motion alone would give.
+        let sentence = match &unjudgeable {
+            Some(_) => would_give(synced, &sentence),
+            None => sentence,
+        };
         return Err(PipelineError::NotDetermined {
             parameters: poor,
-            // The cause is named once, among the causes.
             sentence,
             diagnosis: Box::new(refusal::Diagnosis {
                 causes: match &unjudgeable {
@@ -446,6 +450,17 @@ pub(crate) fn refuse_poorly_determined(
         });
     }
     Ok(calibration)
+}
+
+/// The motion's own verdict `sentence`, as what it would give without the fault that
+/// makes it unjudgeable.
+fn would_give(synced: &Synchronized, sentence: &str) -> String {
+    let without = if synced.unrepaired_timing.is_some() {
+        "with its own acquisition times"
+    } else {
+        "with a heading from the wheels"
+    };
+    format!("{without} the motion would give: {sentence}")
 }
 
 /// Runs the pipeline on a log already in memory. Scan matching runs on rayon's

@@ -36,35 +36,8 @@ const SHOWN: [&str; 17] = [
     "provenance",
 ];
 
-/// Keys of the "Data and solution" section, in order.
-const DATA_KEYS: [&str; 23] = [
-    "log_contents",
-    "samples_used",
-    "samples_synchronized",
-    "samples_trimmed",
-    "scan_pairs",
-    "discarded",
-    "match_rejections",
-    "match_self_check",
-    "stride",
-    "interval_s",
-    "ticks_per_revolution",
-    "sm_sigma",
-    "time_offset_s",
-    "time_offset_sigma_s",
-    "cost_before",
-    "cost_after",
-    "observability",
-    "shared_scan_noise",
-    "consistency",
-    "covariance",
-    "closed_form",
-    "settings",
-    "timing_s",
-];
-
 /// A number with its origin: JSON pointer, unit scale and decimals.
-fn num(pointer: &str, value: f64, scale: f64, digits: usize) -> Markup {
+pub(crate) fn num(pointer: &str, value: f64, scale: f64, digits: usize) -> Markup {
     html! {
         span.num data-json=(pointer) data-scale=(scale) data-digits=(digits) {
             (format!("{:.*}", digits, value * scale))
@@ -73,7 +46,7 @@ fn num(pointer: &str, value: f64, scale: f64, digits: usize) -> Markup {
 }
 
 /// The parameters as the page names them.
-const PARAMETER_LABELS: [&str; 6] = ["r_L", "r_R", "b", "ℓx", "ℓy", "ℓθ"];
+pub(crate) const PARAMETER_LABELS: [&str; 6] = ["r_L", "r_R", "b", "ℓx", "ℓy", "ℓθ"];
 
 /// Significant digits of the numbers shown without a unit of their own.
 const SIGNIFICANT: usize = 6;
@@ -92,54 +65,19 @@ fn significant(x: f64) -> String {
     }
 }
 
-/// The parameters with their units, as column and row headings.
-const PARAMETER_UNITS: [&str; 6] = [
-    "r_L (m)",
-    "r_R (m)",
-    "b (m)",
-    "ℓx (m)",
-    "ℓy (m)",
-    "ℓθ (rad)",
-];
-
-/// A value of the "Data and solution" section: vectors and matrices over the six
-/// parameters (or the three scan-matching components) as tables labelled with names
-/// and units; anything else as [`json`].
-fn labelled(key: &str, v: &Value) -> Markup {
-    let pointer = format!("/{key}");
-    let headings: &[&str] = match key {
-        "covariance" | "closed_form" => &PARAMETER_UNITS,
-        "sm_sigma" => &["x (m)", "y (m)", "θ (rad)"],
-        _ => return json(v, &pointer),
-    };
-    let Some(rows) = v.as_array().filter(|a| a.len() == headings.len()) else {
-        return json(v, &pointer);
-    };
+/// A number with its origin and unit scale, shown to [`SIGNIFICANT`] digits (for
+/// values whose size varies, as covariances).
+pub(crate) fn scaled(pointer: &str, value: f64, scale: f64) -> Markup {
     html! {
-        table.matrix {
-            tr { @if key == "covariance" { th { } } @for h in headings { th { (h) } } }
-            @if key == "covariance" {
-                @for (i, row) in rows.iter().enumerate() {
-                    tr {
-                        th { (headings[i]) }
-                        @for (k, x) in row.as_array().into_iter().flatten().enumerate() {
-                            td { (json(x, &format!("{pointer}/{i}/{k}"))) }
-                        }
-                    }
-                }
-            } @else {
-                tr { @for (i, x) in rows.iter().enumerate() { td { (json(x, &format!("{pointer}/{i}"))) } } }
-            }
-        }
-        @if key == "covariance" {
-            p.note { "Units: the product of the row's and the column's units (m², m·rad, rad²)." }
+        span.num data-json=(pointer) data-scale=(scale) data-sig=(SIGNIFICANT) {
+            (significant(value * scale))
         }
     }
 }
 
 /// A JSON value (numbers to [`SIGNIFICANT`] digits): scalars as text, arrays of numbers inline, arrays of arrays
 /// as a matrix, arrays of objects as a table, objects as a key–value table.
-fn json(v: &Value, pointer: &str) -> Markup {
+pub(crate) fn json(v: &Value, pointer: &str) -> Markup {
     match v {
         Value::Number(n) => html! {
             span.num data-json=(pointer) data-sig=(SIGNIFICANT) { (significant(n.as_f64().unwrap_or(f64::NAN))) }
@@ -190,12 +128,12 @@ fn json(v: &Value, pointer: &str) -> Markup {
 }
 
 /// A JSON pointer token for `key`.
-fn escape_pointer(key: &str) -> String {
+pub(crate) fn escape_pointer(key: &str) -> String {
     key.replace('~', "~0").replace('/', "~1")
 }
 
 /// `snake_case` in words.
-fn words(key: &str) -> String {
+pub(crate) fn words(key: &str) -> String {
     key.replace('_', " ")
 }
 
@@ -367,7 +305,12 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
         .as_object()
         .into_iter()
         .flatten()
-        .filter(|(k, _)| !SHOWN.contains(&k.as_str()) && !DATA_KEYS.contains(&k.as_str()))
+        .filter(|(k, _)| {
+            !SHOWN.contains(&k.as_str())
+                && !crate::data_section::ROWS
+                    .iter()
+                    .any(|row| row.key == k.as_str())
+        })
         .collect();
     let missing = r.observability.motion.missing();
     let halves_short = matches!(
@@ -436,9 +379,7 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
                 }
                 section #data {
                     h2 { "Data and solution" }
-                    table.kv { @for k in DATA_KEYS { @if let Some(x) = v.get(k) {
-                        tr { th { (words(k)) } td { (labelled(k, x)) } }
-                    } } }
+                    (crate::data_section::section(v))
                 }
                 @if !further.is_empty() {
                     section #further {

@@ -17,6 +17,7 @@
 
 #![deny(missing_docs)]
 
+mod data_section;
 pub mod export;
 pub mod figures;
 pub mod html;

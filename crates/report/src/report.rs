@@ -133,6 +133,10 @@ pub struct LogContents {
     pub scans: usize,
     /// ENCODER records read.
     pub encoder_records: usize,
+    /// What the wheel records are called in the summary: `encoder records` for a text
+    /// log, `TOPIC messages` for a bag.
+    #[serde(skip)]
+    pub wheel_records: String,
     /// Malformed lines skipped (lenient mode).
     pub skipped_lines: u64,
     /// The first skipped lines: (1-based line, error).
@@ -191,6 +195,10 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         log_contents: LogContents {
             scans: log.scans.len(),
             encoder_records: log.encoders.len(),
+            wheel_records: match &log.stats.origin {
+                odocal_log::Origin::Text => "encoder records".into(),
+                origin => origin.records(odocal_log::Stream::Wheels),
+            },
             skipped_lines: log.stats.skipped_lines,
             first_skipped: log.stats.first_skipped.clone(),
             unknown_messages: log.stats.unknown.values().sum(),
@@ -269,8 +277,8 @@ impl fmt::Display for Report {
         let c = &self.log_contents;
         writeln!(
             f,
-            "  {} scans, {} encoder records",
-            c.scans, c.encoder_records
+            "  {} scans, {} {}",
+            c.scans, c.encoder_records, c.wheel_records
         )?;
         if c.skipped_lines > 0 {
             let lines: Vec<String> = c.first_skipped.iter().map(|(l, _)| l.to_string()).collect();

@@ -86,10 +86,12 @@ fn numbers_agree(doc: &Html, results: &Value) -> Vec<String> {
                 .expect("data-digits or data-sig")
                 .parse()
                 .unwrap();
+            let scale: f64 = a.attr("data-scale").map_or(1.0, |s| s.parse().unwrap());
+            let expected = expected * scale;
             let tol = 0.5 * 10f64.powi(1 - sig) * expected.abs() * (1.0 + 1e-9);
             assert!(
                 (shown - expected).abs() <= tol,
-                "{pointer}: page shows {text}, results.json has {expected}"
+                "{pointer}: page shows {text}, results.json has {expected} (×{scale})"
             );
         }
         pointers.push(pointer);
@@ -315,17 +317,74 @@ fn coverage_advice_does_not_contradict_the_two_halves_note() {
 }
 
 #[test]
-fn the_covariance_is_a_table_labelled_with_parameters_and_units() {
-    let (opts, outcome, report) = calibrated();
+fn data_and_solution_is_labelled_with_meanings_and_the_summary_units() {
+    // Before: a key-value dump ("a condition", "chi2 limit", "wheel signs —", the
+    // covariance in m² and rad² with no meaning given).
+    let (opts, outcome, mut report) = calibrated();
     let figs = figures(&opts, &outcome, &report).expect("the figures draw");
-    let doc = Html::parse_document(&page(&report, &figs));
-    let headings: Vec<String> = doc
-        .select(&sel("section#data table.matrix th"))
+    let results = serde_json::to_value(&report).unwrap();
+    let doc = Html::parse_document(&page_with_results(&report, &results, &figs));
+    let data = doc
+        .select(&sel("section#data"))
+        .next()
+        .expect("the section");
+    let text: String = data.text().collect();
+    for label in [
+        "Covariance of the estimate",
+        "Closed-form solution",
+        "Scan-matching noise σ",
+        "Observability",
+        "condition number, step 1 (r_L, r_R, b)",
+        "wheel directions",
+        "The two halves of the log",
+        "Clock offset (laser − encoders)",
+        "mm²",
+        "3σ (99.73 %) level",
+    ] {
+        assert!(text.contains(label), "{label:?} missing: {text}");
+    }
+    for raw in [
+        "a condition",
+        "chi2 limit",
+        "wheel signs",
+        "step1",
+        "sm sigma",
+        "(rad)",
+    ] {
+        assert!(!text.contains(raw), "{raw:?} in: {text}");
+    }
+    // Every row says what it means.
+    let rows: Vec<_> = data
+        .select(&sel("table.data > tbody > tr, table.data > tr"))
+        .collect();
+    assert!(rows.len() >= 15, "{} rows", rows.len());
+    for row in rows {
+        let meaning = row.select(&sel("p.meaning")).next();
+        assert!(meaning.is_some(), "{}", row.html());
+    }
+    let headings: Vec<String> = data
+        .select(&sel("table.matrix th"))
         .map(|e| e.text().collect())
         .collect();
+    assert!(headings.iter().any(|h| h == "ℓθ (°)"), "{headings:?}");
     assert!(
-        headings.iter().filter(|h| h.as_str() == "ℓθ (rad)").count() >= 2,
+        headings.iter().filter(|h| h.as_str() == "ℓθ").count() >= 2,
         "{headings:?}"
     );
-    assert!(headings.iter().any(|h| h == "θ (rad)"), "{headings:?}");
+    numbers_agree(&doc, &results);
+    // A two-halves check that could not run says so in a sentence.
+    report.consistency = odocal_pipeline::consistency::Consistency::NotAvailable {
+        reason: "the second half has no straight runs".into(),
+    };
+    let doc = Html::parse_document(&page(&report, &figs));
+    let text: String = doc
+        .select(&sel("section#data"))
+        .next()
+        .unwrap()
+        .text()
+        .collect();
+    assert!(
+        text.contains("Not compared: the second half has no straight runs."),
+        "{text}"
+    );
 }

@@ -10,7 +10,7 @@
 use super::since;
 use super::wraps::steps;
 use crate::finding::{Finding, FindingKind, Severity};
-use odocal_log::{EncoderRecord, WHEEL_TICKS_PER_REVOLUTION};
+use odocal_log::{EncoderRecord, Origin, Stream, WHEEL_TICKS_PER_REVOLUTION};
 use std::f64::consts::TAU;
 
 /// One turn in ticks.
@@ -32,7 +32,7 @@ fn within_one_turn(records: &[EncoderRecord]) -> bool {
 /// Unwraps wheel angles (in [`WHEEL_TICKS_PER_REVOLUTION`] ticks, sorted by time) that
 /// were wrapped to one turn. A note when they were; a warning when a wheel turned more
 /// than a quarter turn between two messages, where the unwrapping may guess wrong.
-pub fn unwrap(records: &mut [EncoderRecord]) -> Option<Finding> {
+pub fn unwrap(records: &mut [EncoderRecord], origin: &Origin) -> Option<Finding> {
     let half = TURN / 2;
     let st = steps(records);
     if !st.iter().flatten().any(|d| d.abs() > half) || !within_one_turn(records) {
@@ -80,10 +80,10 @@ pub fn unwrap(records: &mut [EncoderRecord]) -> Option<Finding> {
             severity,
             format!(
                 "the wheel angles are wrapped to one turn ((−π, π] or [0, 2π), as drivers \
-                 publish continuous joints): {wraps} wrap(s), first at wheel message {} ({}); \
-                 they were unwrapped into continuous angles, exact while a wheel turns less \
-                 than half a turn between messages (here at most {largest_rad:.2} rad){advice}",
-                rec.line,
+                 publish continuous joints): {wraps} wrap(s), first at {} ({}); they were \
+                 unwrapped into continuous angles, exact while a wheel turns less than half a \
+                 turn between messages (here at most {largest_rad:.2} rad){advice}",
+                origin.at(Stream::Wheels, rec.line, rec.t),
                 since(rec.t, records[0].t)
             ),
         )
@@ -133,7 +133,7 @@ mod tests {
         let truth = recs(&angles, |a| a);
         for wrap in [to_pi as fn(f64) -> f64, |a: f64| a.rem_euclid(2.0 * PI)] {
             let mut r = recs(&angles, wrap);
-            let f = unwrap(&mut r).expect("a finding");
+            let f = unwrap(&mut r, &Origin::Text).expect("a finding");
             assert_eq!(f.kind, FindingKind::WheelAngleWrap);
             assert_eq!(f.severity, Severity::Info);
             // 80 rad and 74 rad: 13 + 12 seams at ±π, 12 + 11 at 0.
@@ -146,7 +146,7 @@ mod tests {
     fn sparse_messages_are_a_warning() {
         let angles: Vec<(f64, f64)> = (0..100).map(|k| (1.8 * k as f64, 0.1)).collect();
         let mut r = recs(&angles, to_pi);
-        let f = unwrap(&mut r).expect("a finding");
+        let f = unwrap(&mut r, &Origin::Text).expect("a finding");
         assert_eq!(f.severity, Severity::Warning);
         assert_same_steps(&r, &recs(&angles, |a| a));
     }
@@ -157,12 +157,12 @@ mod tests {
         let angles: Vec<(f64, f64)> = (0..200).map(|k| (0.4 * k as f64, -3.0)).collect();
         let mut r = recs(&angles, |a| a);
         let before = r.clone();
-        assert!(unwrap(&mut r).is_none());
+        assert!(unwrap(&mut r, &Origin::Text).is_none());
         assert_eq!(r, before);
         // Steps over half a turn, but spanning more than one turn: not wrapped.
         let mut r = recs(&[(0.0, 0.0), (0.5, 0.1), (4.0, 0.2), (7.0, 0.3)], |a| a);
         let before = r.clone();
-        assert!(unwrap(&mut r).is_none());
+        assert!(unwrap(&mut r, &Origin::Text).is_none());
         assert_eq!(r, before);
     }
 }

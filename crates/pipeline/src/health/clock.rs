@@ -6,6 +6,7 @@
 
 use super::in_file_order;
 use crate::finding::{Finding, FindingKind};
+use odocal_log::{Origin, Stream};
 
 /// A step back larger than this many median periods (and at least
 /// [`MIN_JUMP_S`]) is a clock jump, not records out of order.
@@ -17,7 +18,8 @@ pub const MIN_JUMP_S: f64 = 1.0;
 /// their stream (found in file order); reports the jumps and the records out of order.
 pub fn keep_longest_run<T: Copy>(
     records: &mut Vec<T>,
-    stream: &str,
+    origin: &Origin,
+    stream: Stream,
     time: impl Fn(&T) -> f64,
     line: impl Fn(&T) -> u64,
 ) -> Vec<Finding> {
@@ -57,9 +59,10 @@ pub fn keep_longest_run<T: Copy>(
             Finding::note(
                 FindingKind::OutOfOrder,
                 format!(
-                    "{small_steps} {stream} record(s) are out of timestamp order (small steps \
-                     back, first at line {}); the stream was sorted by timestamp",
-                    line(&order[k])
+                    "{small_steps} {} are out of timestamp order (small steps back, first at \
+                     {}); the stream was sorted by timestamp",
+                    origin.records(stream),
+                    origin.at(stream, line(&order[k]), times[k])
                 ),
             )
             .count(small_steps)
@@ -79,16 +82,20 @@ pub fn keep_longest_run<T: Copy>(
     records.retain(|r| (lo..=hi).contains(&line(r)));
     let (k, back) = jumps[0];
     let at = line(&order[k]);
+    let place = origin.at(stream, at, times[k]);
     findings.push(
         Finding::warning(
             FindingKind::ClockJump,
             format!(
-                "the {stream} clock jumps back {back:.3} s at line {at} ({} jump(s) in all); \
-                 records on the two sides cannot be put on one time line with the other \
-                 stream, so only the longest stretch (lines {lo}–{hi}) is used and {dropped} \
-                 {stream} record(s) were left out; fix the clock (no clock steps while \
-                 logging) or cut the log at line {at}",
-                jumps.len()
+                "the {} clock jumps back {back:.3} s at {place} ({} jump(s) in all); records \
+                 on the two sides cannot be put on one time line with the other stream, so \
+                 only the longest stretch (from {} to {}) is used and {dropped} {} were left \
+                 out; fix the clock (no clock steps while logging) or cut the log at {place}",
+                origin.stream(stream),
+                jumps.len(),
+                origin.at(stream, lo, times[ks]),
+                origin.at(stream, hi, times[ke - 1]),
+                origin.records(stream)
             ),
         )
         .count(jumps.len() as u64)
@@ -107,7 +114,7 @@ mod tests {
         let mut r: Vec<(f64, u64)> = (0..60).map(|k| (k as f64 * 0.1, k as u64 + 1)).collect();
         r.extend((0..30).map(|k| (1.0 + k as f64 * 0.1, 61 + k as u64)));
         r.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let f = keep_longest_run(&mut r, "laser", |x| x.0, |x| x.1);
+        let f = keep_longest_run(&mut r, &Origin::Text, Stream::Scans, |x| x.0, |x| x.1);
         assert_eq!(f.len(), 1);
         assert_eq!(f[0].kind, FindingKind::ClockJump);
         assert_eq!(f[0].first_line, Some(61));
@@ -121,7 +128,7 @@ mod tests {
         let mut r: Vec<(f64, u64)> = (0..50).map(|k| (k as f64 * 0.1, k as u64 + 1)).collect();
         r[10].0 = 0.85;
         r.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let f = keep_longest_run(&mut r, "encoder", |x| x.0, |x| x.1);
+        let f = keep_longest_run(&mut r, &Origin::Text, Stream::Wheels, |x| x.0, |x| x.1);
         assert_eq!(f.len(), 1);
         assert_eq!(f[0].kind, FindingKind::OutOfOrder);
         assert_eq!(r.len(), 50);

@@ -3,7 +3,7 @@
 //! once), which would otherwise be used twice or give zero-length intervals.
 
 use crate::finding::{Finding, FindingKind};
-use odocal_log::{EncoderRecord, ScanMeta, ScanStore};
+use odocal_log::{EncoderRecord, Origin, ScanMeta, ScanStore, Stream};
 
 /// True when two scans have the same geometry and bit-identical ranges.
 pub(crate) fn same_ranges(store: &ScanStore, a: &ScanMeta, b: &ScanMeta) -> bool {
@@ -53,7 +53,7 @@ fn mean_count(group: &[EncoderRecord], count: impl Fn(&EncoderRecord) -> i64) ->
 
 /// Drops exact repeats of encoder records and merges records sharing a timestamp into
 /// one (their mean count). `records` is sorted by time.
-pub fn encoders(records: &mut Vec<EncoderRecord>) -> Vec<Finding> {
+pub fn encoders(records: &mut Vec<EncoderRecord>, origin: &Origin) -> Vec<Finding> {
     let mut out: Vec<EncoderRecord> = Vec::with_capacity(records.len());
     let (mut repeats, mut merged) = (0u64, 0u64);
     let (mut first_repeat, mut first_merged): (Option<EncoderRecord>, Option<EncoderRecord>) =
@@ -97,10 +97,11 @@ pub fn encoders(records: &mut Vec<EncoderRecord>) -> Vec<Finding> {
             Finding::warning(
                 FindingKind::Duplicate,
                 format!(
-                    "{repeats} ENCODER record(s) repeat an earlier one exactly (same timestamp \
-                     and counts, first at line {}); the repeats were dropped; check that the \
-                     logger writes each message once",
-                    r.line
+                    "{repeats} {} repeat an earlier one exactly (same timestamp and counts, \
+                     first at {}); the repeats were dropped; check that the logger writes each \
+                     message once",
+                    origin.records(Stream::Wheels),
+                    origin.at(Stream::Wheels, r.line, r.t)
                 ),
             )
             .count(repeats)
@@ -113,11 +114,12 @@ pub fn encoders(records: &mut Vec<EncoderRecord>) -> Vec<Finding> {
             Finding::warning(
                 FindingKind::TimestampCollision,
                 format!(
-                    "{merged} ENCODER record(s) share their timestamp with a different record \
-                     (first at line {}; the timestamps step by {res:.3} s at least, as if \
-                     rounded); the records of each timestamp were merged into one (their mean \
-                     count), which blurs the encoder timing; log timestamps to the microsecond",
-                    r.line
+                    "{merged} {} share their timestamp with a different record (first at \
+                     {}; the timestamps step by {res:.3} s at least, as if rounded); the \
+                     records of each timestamp were merged into one (their mean count), which \
+                     blurs the encoder timing; log timestamps to the microsecond",
+                    origin.records(Stream::Wheels),
+                    origin.at(Stream::Wheels, r.line, r.t)
                 ),
             )
             .count(merged)
@@ -130,7 +132,7 @@ pub fn encoders(records: &mut Vec<EncoderRecord>) -> Vec<Finding> {
 
 /// Drops scans repeated exactly (same timestamp and ranges) and keeps only the first
 /// of different scans sharing a timestamp. `scans` is sorted by time.
-pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore) -> Vec<Finding> {
+pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore, origin: &Origin) -> Vec<Finding> {
     let mut out: Vec<ScanMeta> = Vec::with_capacity(scans.len());
     let (mut repeats, mut collisions) = (0u64, 0u64);
     let (mut first_repeat, mut first_collision): (Option<ScanMeta>, Option<ScanMeta>) =
@@ -155,10 +157,11 @@ pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore) -> Vec<Finding> {
             Finding::warning(
                 FindingKind::Duplicate,
                 format!(
-                    "{repeats} scan(s) repeat an earlier one exactly (same timestamp and ranges, \
-                     first at line {}); the repeats were dropped (used twice they would make \
-                     the σ's too small); check that the logger writes each message once",
-                    s.line
+                    "{repeats} {} repeat an earlier one exactly (same timestamp and ranges, \
+                     first at {}); the repeats were dropped (used twice they would make the σ's \
+                     too small); check that the logger writes each message once",
+                    origin.records(Stream::Scans),
+                    origin.at(Stream::Scans, s.line, s.t)
                 ),
             )
             .count(repeats)
@@ -170,10 +173,11 @@ pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore) -> Vec<Finding> {
             Finding::warning(
                 FindingKind::TimestampCollision,
                 format!(
-                    "{collisions} scan(s) share their timestamp with a different scan (first at \
-                     line {}); only the first scan of each timestamp was kept; log timestamps \
-                     to the microsecond",
-                    s.line
+                    "{collisions} {} share their timestamp with a different scan (first at \
+                     {}); only the first scan of each timestamp was kept; log timestamps to the \
+                     microsecond",
+                    origin.records(Stream::Scans),
+                    origin.at(Stream::Scans, s.line, s.t)
                 ),
             )
             .count(collisions)
@@ -209,7 +213,7 @@ mod tests {
                 ..recs[4]
             },
         );
-        let _ = encoders(&mut recs);
+        let _ = encoders(&mut recs, &Origin::Text);
         assert_eq!(recs.len(), 10);
         for (k, r) in recs.iter().enumerate() {
             let k = k as i64;

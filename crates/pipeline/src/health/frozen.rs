@@ -5,10 +5,10 @@
 use super::duplicates::same_ranges;
 use super::since;
 use crate::finding::{Finding, FindingKind};
-use odocal_log::{ScanMeta, ScanStore};
+use odocal_log::{Origin, ScanMeta, ScanStore, Stream};
 
 /// Drops scans identical to the scan before them. `scans` is sorted by time.
-pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore) -> Vec<Finding> {
+pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore, origin: &Origin) -> Vec<Finding> {
     let total = scans.len();
     let mut out: Vec<ScanMeta> = Vec::with_capacity(total);
     let mut dropped = 0u64;
@@ -35,11 +35,11 @@ pub fn scans(scans: &mut Vec<ScanMeta>, store: &ScanStore) -> Vec<Finding> {
     vec![Finding::warning(
         FindingKind::FrozenScan,
         format!(
-            "{dropped} of {total} scans are identical to the scan before them (first at line \
-             {}, {}; the longest frozen stretch lasts {longest:.1} s): the laser driver \
-             delivered a frozen scan; the repeats were left out; check the laser's driver \
-             and connection",
-            f.line,
+            "{dropped} of {total} {} are identical to the scan before them (first at {}, {}; \
+             the longest frozen stretch lasts {longest:.1} s): the laser driver delivered a \
+             frozen scan; the repeats were left out; check the laser's driver and connection",
+            origin.records(Stream::Scans),
+            origin.at(Stream::Scans, f.line, f.t),
             since(f.t, t0)
         ),
     )

@@ -3,6 +3,7 @@
 
 use super::since;
 use crate::finding::{Finding, FindingKind, Severity};
+use odocal_log::{Origin, Stream};
 
 /// A step longer than this many median periods (and at least [`MIN_GAP_S`]) is a gap.
 pub const GAP_PERIODS: f64 = 5.0;
@@ -12,7 +13,8 @@ pub const MIN_GAP_S: f64 = 0.05;
 /// Finds the gaps of a stream sorted by time.
 pub fn find<T>(
     records: &[T],
-    stream: &str,
+    origin: &Origin,
+    stream: Stream,
     time: impl Fn(&T) -> f64,
     line: impl Fn(&T) -> u64,
 ) -> Option<Finding> {
@@ -45,12 +47,13 @@ pub fn find<T>(
                 Severity::Info
             },
             format!(
-                "the {stream} stream has {count} gap(s) longer than {threshold:.3} s ({:.0} % of \
-                 its {span:.1} s); the longest, {:.3} s, ends at line {} ({}); scan pairs across \
-                 a gap are discarded; check the logger for dropped messages",
+                "the {} stream has {count} gap(s) longer than {threshold:.3} s ({:.0} % of its \
+                 {span:.1} s); the longest, {:.3} s, ends at {} ({}); scan pairs across a gap \
+                 are discarded; check the logger for dropped messages",
+                origin.stream(stream),
                 100.0 * share,
                 longest.0,
-                line(&records[k]),
+                origin.at(stream, line(&records[k]), times[k]),
                 since(times[k - 1], times[0])
             ),
         )

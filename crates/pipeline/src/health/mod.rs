@@ -31,7 +31,7 @@ use crate::finding::Finding;
 use crate::options::Options;
 use crate::synchronized::Synchronized;
 use odocal_log::{
-    EncoderRecord, Log, ScanMeta, ScanStore, ValueSource, WHEEL_TICKS_PER_REVOLUTION,
+    EncoderRecord, Log, ScanMeta, ScanStore, Stream, ValueSource, WHEEL_TICKS_PER_REVOLUTION,
 };
 use std::borrow::Cow;
 
@@ -79,30 +79,40 @@ pub fn check_log_and_read_times<'a>(
 
     let mut encoders: Vec<EncoderRecord> = log.encoders.clone();
     let mut scans: Vec<ScanMeta> = log.scans.scans.clone();
+    let origin = &log.stats.origin;
     findings.extend(clock::keep_longest_run(
         &mut encoders,
-        "encoder",
+        origin,
+        Stream::Wheels,
         |r| r.t,
         |r| r.line,
     ));
     findings.extend(clock::keep_longest_run(
         &mut scans,
-        "laser",
+        origin,
+        Stream::Scans,
         |s| s.t,
         |s| s.line,
     ));
-    findings.extend(duplicates::encoders(&mut encoders));
-    findings.extend(duplicates::scans(&mut scans, &log.scans));
-    findings.extend(frozen::scans(&mut scans, &log.scans));
+    findings.extend(duplicates::encoders(&mut encoders, origin));
+    findings.extend(duplicates::scans(&mut scans, &log.scans, origin));
+    findings.extend(frozen::scans(&mut scans, &log.scans, origin));
     if angles_in_radians(log) {
-        findings.extend(angle_wraps::unwrap(&mut encoders));
+        findings.extend(angle_wraps::unwrap(&mut encoders, origin));
     }
     if log.params.encoder_modulus.is_none() {
-        findings.extend(wraps::unwrap(&mut encoders));
+        findings.extend(wraps::unwrap(&mut encoders, origin));
     }
-    findings.extend(spikes::repair(&mut encoders, ticks));
-    findings.extend(gaps::find(&encoders, "encoder", |r| r.t, |r| r.line));
-    findings.extend(gaps::find(&scans, "laser", |s| s.t, |s| s.line));
+    findings.extend(spikes::repair(&mut encoders, ticks, origin));
+    let (t, line) = (|r: &EncoderRecord| r.t, |r: &EncoderRecord| r.line);
+    findings.extend(gaps::find(&encoders, origin, Stream::Wheels, t, line));
+    findings.extend(gaps::find(
+        &scans,
+        origin,
+        Stream::Scans,
+        |s| s.t,
+        |s| s.line,
+    ));
     if let Some(j) = read_jitter::estimate(&encoders) {
         let half =
             read_jitter::smoothing_half_width(j.sigma_t, read_jitter::median_spacing(&encoders));

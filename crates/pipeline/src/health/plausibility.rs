@@ -10,7 +10,7 @@
 
 use crate::error::PipelineError;
 use crate::sync::median_period;
-use odocal_log::{EncoderRecord, Log, ScanKind};
+use odocal_log::{EncoderRecord, Log, ScanKind, Stream};
 
 /// Longest plausible median time between two scans, or two encoder records (s).
 pub const MAX_PERIOD_S: f64 = 10.0;
@@ -32,7 +32,7 @@ fn likely_unit(period: f64) -> Option<(&'static str, f64)> {
 }
 
 /// An error when the median period of a stream is implausibly long.
-fn check_period(what: &str, times: &[f64], first_line: u64) -> Result<(), PipelineError> {
+fn check_period(what: &str, times: &[f64], first: &str) -> Result<(), PipelineError> {
     let Some(period) = median_period(times) else {
         return Ok(());
     };
@@ -52,22 +52,25 @@ fn check_period(what: &str, times: &[f64], first_line: u64) -> Result<(), Pipeli
         ),
     };
     Err(PipelineError::Implausible(format!(
-        "{cause} (first at line {first_line})"
+        "{cause} (first at {first})"
     )))
 }
 
 /// The median wheel speed (revolutions per second, the faster wheel) between
-/// consecutive records where a wheel turned, with the record line where it was
-/// first that fast; `None` when the wheels never turn.
-fn median_wheel_speed(encoders: &[EncoderRecord], ticks_per_rev: f64) -> Option<(f64, u64)> {
-    let mut speeds: Vec<(f64, u64)> = encoders
+/// consecutive records where a wheel turned, with the record where it was first that
+/// fast; `None` when the wheels never turn.
+fn median_wheel_speed(
+    encoders: &[EncoderRecord],
+    ticks_per_rev: f64,
+) -> Option<(f64, EncoderRecord)> {
+    let mut speeds: Vec<(f64, EncoderRecord)> = encoders
         .windows(2)
         .filter_map(|w| {
             let dt = w[1].t - w[0].t;
             let dl = (i128::from(w[1].left) - i128::from(w[0].left)).unsigned_abs();
             let dr = (i128::from(w[1].right) - i128::from(w[0].right)).unsigned_abs();
             let ticks = dl.max(dr) as f64;
-            (dt > 0.0 && ticks > 0.0).then(|| (ticks / dt / ticks_per_rev, w[1].line))
+            (dt > 0.0 && ticks > 0.0).then(|| (ticks / dt / ticks_per_rev, w[1]))
         })
         .collect();
     if speeds.is_empty() {
@@ -99,17 +102,25 @@ fn check_flaser_geometry(log: &Log) -> Result<(), PipelineError> {
 pub fn check(log: &Log, ticks_per_rev: f64) -> Result<(), PipelineError> {
     check_flaser_geometry(log)?;
     let scan_times: Vec<f64> = log.scans.scans.iter().map(|s| s.t).collect();
-    let scan_line = log.scans.scans.first().map_or(0, |s| s.line);
-    check_period("scans", &scan_times, scan_line)?;
+    let origin = &log.stats.origin;
+    let first_scan = log.scans.scans.first().map_or((0, 0.0), |s| (s.line, s.t));
+    let first_scan = origin.at(Stream::Scans, first_scan.0, first_scan.1);
+    check_period(&origin.records(Stream::Scans), &scan_times, &first_scan)?;
     let encoder_times: Vec<f64> = log.encoders.iter().map(|e| e.t).collect();
-    let encoder_line = log.encoders.first().map_or(0, |e| e.line);
-    check_period("encoder records", &encoder_times, encoder_line)?;
-    if let Some((speed, line)) = median_wheel_speed(&log.encoders, ticks_per_rev) {
+    let first_encoder = log.encoders.first().map_or((0, 0.0), |e| (e.line, e.t));
+    let first_encoder = origin.at(Stream::Wheels, first_encoder.0, first_encoder.1);
+    check_period(
+        &origin.records(Stream::Wheels),
+        &encoder_times,
+        &first_encoder,
+    )?;
+    if let Some((speed, rec)) = median_wheel_speed(&log.encoders, ticks_per_rev) {
+        let line = origin.at(Stream::Wheels, rec.line, rec.t);
         if speed > MAX_WHEEL_REV_PER_S {
             return Err(PipelineError::Implausible(format!(
                 "with {ticks_per_rev} ticks per revolution the encoder counts turn a wheel at \
-                 {speed:.3e} revolutions per second (median while moving, e.g. up to line \
-                 {line}), where no robot wheel turns faster than {MAX_WHEEL_REV_PER_S}: the \
+                 {speed:.3e} revolutions per second (median while moving, e.g. up to {line}), \
+                 where no robot wheel turns faster than {MAX_WHEEL_REV_PER_S}: the \
                  counts are in another scale or the ticks per revolution are wrong — give \
                  the right value with --ticks-per-rev or PARAM robot_wheel_ticks_per_revolution"
             )));
@@ -137,15 +148,17 @@ mod tests {
     #[test]
     fn time_units_are_named() {
         let secs: Vec<f64> = (0..50).map(|k| k as f64 * 0.1).collect();
-        assert!(check_period("scans", &secs, 1).is_ok());
+        assert!(check_period("scans", &secs, "line 1").is_ok());
         for (per_s, unit) in [(1e3, "milli"), (1e6, "micro"), (1e9, "nano")] {
             let t: Vec<f64> = secs.iter().map(|s| s * per_s + 1.7e9 * per_s).collect();
-            let e = check_period("scans", &t, 7).unwrap_err().to_string();
+            let e = check_period("scans", &t, "line 7").unwrap_err().to_string();
             assert!(e.contains(&format!("{unit}seconds")), "{e}");
             assert!(e.contains("line 7"), "{e}");
         }
         let absurd: Vec<f64> = (0..50).map(|k| k as f64 * 1e298).collect();
-        let e = check_period("scans", &absurd, 1).unwrap_err().to_string();
+        let e = check_period("scans", &absurd, "line 1")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("not seconds"), "{e}");
     }
 

@@ -4,7 +4,7 @@
 
 use super::wraps::steps;
 use crate::finding::{Finding, FindingKind};
-use odocal_log::EncoderRecord;
+use odocal_log::{EncoderRecord, Origin, Stream};
 use std::f64::consts::TAU;
 
 /// A wheel speed this many times the 99th percentile of the log's speeds is
@@ -51,6 +51,7 @@ fn limit(rates: &[[f64; 2]], ticks_per_revolution: Option<f64>) -> f64 {
 pub fn repair(
     records: &mut Vec<EncoderRecord>,
     ticks_per_revolution: Option<f64>,
+    origin: &Origin,
 ) -> Option<Finding> {
     if records.len() < 3 {
         return None;
@@ -141,11 +142,12 @@ pub fn repair(
         Finding::warning(
             FindingKind::EncoderSpike,
             format!(
-                "ENCODER counts jump at a physically impossible wheel speed (up to {speed}, \
-                 first at line {}): {spikes} isolated bad record(s) were dropped and {bridged} \
-                 lasting jump(s) (counter resets) bridged with the speed around them; check the \
-                 encoder wiring and the logger",
-                f.line
+                "the {} jump at a physically impossible wheel speed (up to {speed}, first at \
+                 {}): {spikes} isolated bad record(s) were dropped and {bridged} lasting \
+                 jump(s) (counter resets) bridged with the speed around them; check the encoder \
+                 wiring and the logger",
+                origin.records(Stream::Wheels),
+                origin.at(Stream::Wheels, f.line, f.t)
             ),
         )
         .count(spikes + bridged)
@@ -173,7 +175,7 @@ mod tests {
         let mut r = recs(200);
         r[74].left += 1_000_000_000_000;
         r[90].right = i64::MAX;
-        let f = repair(&mut r, Some(1000.0)).expect("a finding");
+        let f = repair(&mut r, Some(1000.0), &Origin::Text).expect("a finding");
         assert_eq!(f.count, 2);
         assert_eq!(f.first_line, Some(75));
         assert_eq!(r.len(), 198);
@@ -186,7 +188,7 @@ mod tests {
         for x in &mut r[100..] {
             x.left += 5_000_000;
         }
-        let f = repair(&mut r, Some(1000.0)).expect("a finding");
+        let f = repair(&mut r, Some(1000.0), &Origin::Text).expect("a finding");
         assert_eq!(f.count, 1);
         assert_eq!(r.len(), 200);
         assert!(r.windows(2).all(|w| w[1].left - w[0].left == 3));
@@ -195,6 +197,6 @@ mod tests {
     #[test]
     fn ordinary_counts_are_left_alone() {
         let mut r = recs(200);
-        assert!(repair(&mut r, Some(1000.0)).is_none());
+        assert!(repair(&mut r, Some(1000.0), &Origin::Text).is_none());
     }
 }

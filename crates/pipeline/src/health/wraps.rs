@@ -3,7 +3,7 @@
 //! away from an ordinary step — and the counts are unwrapped.
 
 use crate::finding::{Finding, FindingKind};
-use odocal_log::EncoderRecord;
+use odocal_log::{EncoderRecord, Origin, Stream};
 
 /// Smallest modulus considered: 2^8.
 const MIN_BITS: u32 = 8;
@@ -49,7 +49,7 @@ fn modulus_of(step: i128, ordinary: f64) -> Option<i128> {
 }
 
 /// Infers a counter modulus from jumps of about ±2^k ticks and unwraps the counts.
-pub fn unwrap(records: &mut [EncoderRecord]) -> Option<Finding> {
+pub fn unwrap(records: &mut [EncoderRecord], origin: &Origin) -> Option<Finding> {
     let st = steps(records);
     let typical = typical_step(&st);
     let ordinary = 4.0 * (typical + 1.0);
@@ -115,9 +115,9 @@ pub fn unwrap(records: &mut [EncoderRecord]) -> Option<Finding> {
             FindingKind::EncoderWrap,
             format!(
                 "the encoder counters wrap at {m} (2^{bits}): {wraps} jump(s) of ±{m} ticks, \
-                 first at line {}, and the log gives no modulus; the counts were unwrapped; add \
+                 first at {}, and the log gives no modulus; the counts were unwrapped; add \
                  `PARAM robot_encoder_modulus {m}` to the log or pass `--encoder-modulus {m}`",
-                rec.line
+                origin.at(Stream::Wheels, rec.line, rec.t)
             ),
         )
         .count(wraps)
@@ -150,7 +150,7 @@ mod tests {
             .map(|&(l, r)| (l.rem_euclid(65536), r.rem_euclid(65536)))
             .collect();
         let mut r = recs(&wrapped);
-        let f = unwrap(&mut r).expect("a finding");
+        let f = unwrap(&mut r, &Origin::Text).expect("a finding");
         assert_eq!(f.kind, FindingKind::EncoderWrap);
         assert!(f.message.contains("65536"), "{}", f.message);
         for (a, b) in r.windows(2).zip(truth.windows(2)) {
@@ -163,7 +163,7 @@ mod tests {
     fn ordinary_counts_are_left_alone() {
         let mut r = recs(&(0..300).map(|k| (3 * k, -2 * k)).collect::<Vec<_>>());
         let before = r.clone();
-        assert!(unwrap(&mut r).is_none());
+        assert!(unwrap(&mut r, &Origin::Text).is_none());
         assert_eq!(r, before);
     }
 }
