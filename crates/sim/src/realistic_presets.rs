@@ -20,8 +20,8 @@ pub const REALISTIC_PRESETS: [&str; 3] = ["mines-rover", "neato-lds", "turtlebot
 
 impl LaserConfig {
     /// A real Hokuyo URG-04LX as on the MinesRover logs: 682 rays 2π/1024 apart over
-    /// 240°, 10 Hz, swept, 0.02–5.6 m; σ = 6 mm + 0.4 % of the range, correlated over
-    /// 2 rays; 1 % random failures; returns fading beyond 4 m and past 70° incidence;
+    /// 240°, 10 Hz, swept, 0.02–5.6 m; σ = 5 mm + 0.25 % of the range (the data
+    /// sheet's ±10 mm up to 1 m, ±1 % beyond, as about ±2σ), correlated over 2 rays; 1 % random failures; returns fading beyond 4 m and past 70° incidence;
     /// mixed pixels at half the depth edges; a bias of 3 mm + 4 mm/m² · r² (1.6 % at
     /// 4 m) and a 20 mm warm-up drift (time constant 3 min).
     pub fn urg_04lx_realistic() -> Self {
@@ -34,7 +34,7 @@ impl LaserConfig {
             min_range: 0.02,
             rate_hz: 10.0,
             jitter_s: 0.0,
-            range_sigma: 0.006,
+            range_sigma: 0.005,
             correlation_rays: 2,
             quantization: 0.001,
             dropout_probability: 0.01,
@@ -49,16 +49,16 @@ impl LaserConfig {
                 bias_quadratic: 0.004,
                 drift: 0.02,
                 drift_time: 180.0,
-                sigma_per_metre: 0.004,
+                sigma_per_metre: 0.0025,
             }),
         }
     }
 
     /// A Neato-class 360° LDS: 361 rays 1° apart from 0°, 5 Hz, swept, 0.06–5 m;
-    /// σ = 8 mm + 1 % of the range; a weak receiver: readings flagged
-    /// invalid at random (45 %), returns fading beyond 2 m and past 55° incidence (about 75 %
-    /// of the readings invalid in an office, 40–80 returns per scan); mixed pixels;
-    /// a bias of 2 mm/m² · r² and a 10 mm drift.
+    /// σ = 6 mm + 0.4 % of the range; a weak receiver: half the returns lost at
+    /// 1.3 m, fading past 55° incidence, 2 % random failures (about 80 % of the
+    /// readings invalid in an office, 40–110 returns per scan); mixed pixels; a bias
+    /// of 2 mm/m² · r² and a 10 mm drift.
     pub fn neato_lds() -> Self {
         LaserConfig {
             num_rays: 361,
@@ -68,14 +68,14 @@ impl LaserConfig {
             min_range: 0.06,
             rate_hz: 5.0,
             jitter_s: 0.0,
-            range_sigma: 0.008,
+            range_sigma: 0.006,
             correlation_rays: 1,
             quantization: 0.001,
-            dropout_probability: 0.45,
+            dropout_probability: 0.02,
             time_increment: 0.2 / 361.0,
             laser_type: 99,
             realism: Some(RealisticLaser {
-                half_return_range: 2.0,
+                half_return_range: 1.3,
                 grazing_angle: 55f64.to_radians(),
                 mixed_pixel_probability: 0.5,
                 depth_edge: 0.1,
@@ -83,13 +83,14 @@ impl LaserConfig {
                 bias_quadratic: 0.002,
                 drift: 0.01,
                 drift_time: 120.0,
-                sigma_per_metre: 0.01,
+                sigma_per_metre: 0.004,
             }),
         }
     }
 
     /// An RPLIDAR A1 as on a TurtleBot 4: 720 rays 0.5° apart from −180°, 7.7 Hz,
-    /// swept, 0.15–12 m; σ = 4 mm + 0.8 % of the range; 5 % random failures; returns
+    /// swept, 0.15–12 m; σ = 3 mm + 0.5 % of the range (the data sheet's 1 % up to
+    /// 3 m, 2 % to 5 m, as about ±2σ); 5 % random failures; returns
     /// fading beyond 6 m and past 75° incidence; mixed pixels at 70 % of the depth
     /// edges (its well-known trails); a bias of 2 mm + 1 mm/m² · r² and a 5 mm drift.
     pub fn rplidar() -> Self {
@@ -101,7 +102,7 @@ impl LaserConfig {
             min_range: 0.15,
             rate_hz: 7.7,
             jitter_s: 0.0,
-            range_sigma: 0.004,
+            range_sigma: 0.003,
             correlation_rays: 1,
             quantization: 0.001,
             dropout_probability: 0.05,
@@ -116,7 +117,7 @@ impl LaserConfig {
                 bias_quadratic: 0.001,
                 drift: 0.005,
                 drift_time: 120.0,
-                sigma_per_metre: 0.008,
+                sigma_per_metre: 0.005,
             }),
         }
     }
@@ -133,9 +134,10 @@ pub(crate) fn preset(name: &str, base: SimConfig) -> Option<SimConfig> {
     }
 }
 
-/// A six-wheel skid-steer rover like the MinesRover: wheel radii 76.8 / 77.4 mm, an
-/// effective wheel distance of 398 mm (skid steering turns less than the 330 mm track
-/// suggests), the URG-04LX 152 mm ahead; up to 0.6 m/s and 1 rad/s; 2000-tick
+/// A six-wheel skid-steer rover like the MinesRover, with about what odocal finds on
+/// its real logs (docs/benchmarks.md): wheel radii 74.6 / 74.1 mm, an effective wheel
+/// distance of 305 mm (nominal 77 mm and 330 mm), the URG-04LX 94 mm ahead, 6 mm to
+/// the left, turned by −0.033 rad (nominal 145 mm ahead); up to 0.6 m/s and 1 rad/s; 2000-tick
 /// encoders read with each scan; three short slip episodes a minute (the wheels skid
 /// in turns); in the cluttered hall, 120 s.
 fn mines_rover(base: SimConfig) -> SimConfig {
@@ -144,10 +146,10 @@ fn mines_rover(base: SimConfig) -> SimConfig {
         hostname: "minesrover".into(),
         world: "hall-cluttered".into(),
         robot: RobotParams {
-            r_l: 0.0768,
-            r_r: 0.0774,
-            b: 0.398,
-            laser: Pose2::new(0.152, 0.006, -0.011),
+            r_l: 0.0746,
+            r_r: 0.0741,
+            b: 0.305,
+            laser: Pose2::new(0.094, 0.006, -0.033),
         },
         nominal: RobotParams {
             r_l: 0.077,

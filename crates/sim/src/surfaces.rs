@@ -106,8 +106,8 @@ impl World {
         self
     }
 
-    /// The same world with people walking in it. They are seen by the laser but not
-    /// avoided by the planner (they step aside).
+    /// The same world with people walking in it. Only the realistic laser sees them;
+    /// the planner does not avoid them (the robot drives through them).
     pub fn with_walkers(mut self, walkers: Vec<Walker>) -> Self {
         self.set_walkers(walkers);
         self
