@@ -137,9 +137,10 @@ pub(crate) fn preset(name: &str, base: SimConfig) -> Option<SimConfig> {
 /// A six-wheel skid-steer rover like the MinesRover, with about what odocal finds on
 /// its real logs (docs/benchmarks.md): wheel radii 74.6 / 74.1 mm, an effective wheel
 /// distance of 305 mm (nominal 77 mm and 330 mm), the URG-04LX 94 mm ahead, 6 mm to
-/// the left, turned by −0.033 rad (nominal 145 mm ahead); up to 0.6 m/s and 1 rad/s; 2000-tick
-/// encoders read with each scan; three short slip episodes a minute (the wheels skid
-/// in turns); in the cluttered hall, 120 s.
+/// the left, turned by −0.033 rad (nominal 145 mm ahead); up to 0.6 m/s and 1 rad/s;
+/// sliding outward in turns (lateral slip 0.05 s: 3° at 1 rad/s); 2000-tick encoders
+/// read with each scan; three short slip episodes a minute; in the cluttered hall,
+/// 120 s.
 fn mines_rover(base: SimConfig) -> SimConfig {
     SimConfig {
         duration: 120.0,
@@ -165,6 +166,7 @@ fn mines_rover(base: SimConfig) -> SimConfig {
         },
         motors: MotorConfig {
             time_constant: 0.3,
+            lateral_slip: 0.05,
             ..MotorConfig::default()
         },
         encoder: EncoderConfig {
