@@ -289,7 +289,7 @@ fn measurement_finds_the_clean_presets_clean() {
 
 /// The table of docs/benchmarks.md: 120 s of each realistic preset, three seeds.
 #[test]
-#[ignore = "heavy: about a minute; prints the table of docs/benchmarks.md"]
+#[ignore = "heavy (about 20 s): prints the table of docs/benchmarks.md"]
 fn realistic_presets_match_table() {
     println!("{TABLE_HEADER}");
     for preset in REALISTIC_PRESETS {
@@ -357,4 +357,40 @@ fn realistic_effects_ablation() {
             println!("{}", y.row(&format!("{preset}: {label}")));
         }
     }
+}
+
+/// The realistic presets are on the command line: listed, and simulated with their
+/// truth file (which names the realistic laser and the cluttered world).
+#[test]
+fn realistic_presets_are_on_the_command_line() {
+    let odocal = env!("CARGO_BIN_EXE_odocal");
+    let out = std::process::Command::new(odocal)
+        .args(["simulate", "--list-presets"])
+        .output()
+        .expect("run odocal");
+    let listed = String::from_utf8_lossy(&out.stdout);
+    let dir = std::env::temp_dir().join(format!("odocal-realistic-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    for preset in REALISTIC_PRESETS {
+        assert!(
+            listed.lines().any(|l| l == preset),
+            "{preset} not in\n{listed}"
+        );
+        let prefix = dir.join(preset);
+        let out = std::process::Command::new(odocal)
+            .args(["simulate", "--preset", preset, "--duration", "2", "--out"])
+            .arg(&prefix)
+            .output()
+            .expect("run odocal");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let truth = std::fs::read_to_string(prefix.with_extension("truth.json")).unwrap();
+        let truth: serde_json::Value = serde_json::from_str(&truth).unwrap();
+        assert!(truth["config"]["laser"]["realism"].is_object(), "{preset}");
+        assert!(truth["world"].as_str().unwrap().ends_with("-cluttered"));
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }
