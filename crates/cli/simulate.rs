@@ -12,7 +12,9 @@ use std::path::{Path, PathBuf};
 #[derive(clap::Args, Debug)]
 pub struct Args {
     /// Preset to start from: khepera, turtlebot, pioneer, khepera-displaced, office,
-    /// corridor, straight-only, spin-only, identical-turns, or a row of the Table I file.
+    /// corridor, straight-only, spin-only, identical-turns, the realistic mines-rover,
+    /// neato-lds and turtlebot4-rplidar (sparse, cluttered scans of real sensors; see
+    /// docs/realistic-presets.md), or a row of the Table I file.
     #[arg(long, default_value = "khepera")]
     preset: String,
     /// Seed of every random choice (same seed and options → same bytes).
@@ -78,15 +80,17 @@ pub struct Args {
     /// Scan timing jitter (± s, uniform).
     #[arg(long)]
     scan_jitter: Option<f64>,
-    /// Laser model: urg-04lx, lds (360°, 5 Hz) or sick (180°, clockwise); each sweeps
-    /// its rays (see --no-sweep). Default: the preset's.
+    /// Laser model: urg-04lx, lds (360°, 5 Hz), sick (180°, clockwise), or the
+    /// realistic urg-04lx-realistic, neato-lds and rplidar; each sweeps its rays (see
+    /// --no-sweep). Default: the preset's.
     #[arg(long)]
     laser: Option<String>,
     /// Every ray of a scan at the scan's timestamp (no sweep, no
     /// laser_front_laser_time_increment PARAM).
     #[arg(long)]
     no_sweep: bool,
-    /// World: khepera-arena, office, corridor or hall.
+    /// World: khepera-arena, office, corridor, hall, or the realistic office-cluttered
+    /// and hall-cluttered (glass, dark furniture, clutter, people).
     #[arg(long)]
     world: Option<String>,
     /// Trajectory: mixed, straight-only, spin-only, identical-turns or no-spins (a joystick

@@ -97,11 +97,13 @@ impl SimConfig {
         }
         if self.motors.substep_us == 0
             || !(self.motors.time_constant >= 0.0 && self.motors.time_constant <= 10.0)
+            || !(self.motors.lateral_slip >= 0.0 && self.motors.lateral_slip <= 1.0)
         {
             return Err(SimError::InvalidConfig {
                 field: "motors",
                 value: format!("{:?}", self.motors),
-                expected: "substep_us ≥ 1 and a time constant in [0, 10] s",
+                expected:
+                    "substep_us ≥ 1, a time constant in [0, 10] s and a lateral slip in [0, 1] s",
             });
         }
         self.robot.validate()?;

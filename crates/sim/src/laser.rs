@@ -4,6 +4,7 @@
 //! [`LaserConfig::time_increment`] is set (the sweep; see [`crate::laser_models`]).
 
 use crate::error::SimError;
+use crate::realistic_laser::RealisticLaser;
 use crate::world::World;
 use odocal_geom::Pose2;
 use odocal_log::{LaserFields, ScanGeometry};
@@ -47,6 +48,11 @@ pub struct LaserConfig {
     /// other).
     #[serde(default = "hokuyo_urg_type", skip_serializing_if = "is_hokuyo_urg")]
     pub laser_type: i32,
+    /// The realistic error model (sparse returns, mixed pixels, bias and drift, noise
+    /// growing with range; see [`RealisticLaser`]); `None` (the default) for the plain
+    /// model above.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub realism: Option<RealisticLaser>,
 }
 
 // The two settings are left out of the configuration JSON at their defaults, so that
@@ -83,6 +89,7 @@ impl Default for LaserConfig {
             dropout_probability: 0.001,
             time_increment: 0.0,
             laser_type: hokuyo_urg_type(),
+            realism: None,
         }
     }
 }
@@ -204,6 +211,9 @@ impl LaserConfig {
                 "a probability in [0, 1]",
             );
         }
+        if let Some(r) = &self.realism {
+            r.validate(self.range_sigma)?;
+        }
         Ok(())
     }
 
@@ -282,7 +292,7 @@ impl LaserConfig {
 
     /// Per-ray noise (m): a moving sum of `correlation_rays` white Gaussian values,
     /// scaled so that each ray's standard deviation is `range_sigma`.
-    fn correlated_noise<R: Rng + ?Sized>(&self, rng: &mut R) -> Vec<f64> {
+    pub(crate) fn correlated_noise<R: Rng + ?Sized>(&self, rng: &mut R) -> Vec<f64> {
         if self.range_sigma == 0.0 {
             return vec![0.0; self.num_rays];
         }

@@ -7,7 +7,14 @@ use crate::laser::LaserConfig;
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// Names accepted by [`LaserConfig::model`].
-pub const LASER_MODELS: [&str; 3] = ["urg-04lx", "lds", "sick"];
+pub const LASER_MODELS: [&str; 6] = [
+    "urg-04lx",
+    "lds",
+    "sick",
+    "urg-04lx-realistic",
+    "neato-lds",
+    "rplidar",
+];
 
 impl LaserConfig {
     /// A laser model by name (see [`LASER_MODELS`]), sweeping (`time_increment` set);
@@ -17,6 +24,9 @@ impl LaserConfig {
             "urg-04lx" | "urg" | "hokuyo" => Ok(LaserConfig::urg_04lx()),
             "lds" => Ok(LaserConfig::lds()),
             "sick" | "sick-lms" => Ok(LaserConfig::sick()),
+            "urg-04lx-realistic" => Ok(LaserConfig::urg_04lx_realistic()),
+            "neato-lds" => Ok(LaserConfig::neato_lds()),
+            "rplidar" => Ok(LaserConfig::rplidar()),
             _ => Err(SimError::UnknownName {
                 what: "laser model",
                 name: name.to_string(),
@@ -53,6 +63,7 @@ impl LaserConfig {
             dropout_probability: 0.01,
             time_increment: 0.2 / 360.0,
             laser_type: 99,
+            realism: None,
         }
     }
 
@@ -75,6 +86,7 @@ impl LaserConfig {
             dropout_probability: 0.001,
             time_increment: 1.0 / (75.0 * 360.0),
             laser_type: 0,
+            realism: None,
         }
     }
 

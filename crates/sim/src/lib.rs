@@ -12,6 +12,11 @@
 //!   integrated exactly (circular arcs over piecewise-constant wheel speeds).
 //! - [`Planner`] / [`TrajectoryKind`]: mixed and degenerate trajectories.
 //! - [`EncoderConfig`], [`FaultConfig`]: encoder counts and injected faults.
+//! - The realistic mode, off by default: [`RealisticLaser`] (sparse returns, mixed
+//!   pixels, range bias and drift, noise growing with range), [`Surface`]s (dark,
+//!   glass) and [`Walker`]s in the cluttered worlds ([`World::office_cluttered`],
+//!   [`World::hall_cluttered`]), and the presets of real sensor classes
+//!   ([`REALISTIC_PRESETS`]; docs/realistic-presets.md).
 //!
 //! And the whole: [`SimConfig`] (or [`SimConfig::preset`]) → [`simulate`] →
 //! [`SimRun`] (every record with its truth, in memory) → [`SimRun::write_log`] and
@@ -44,8 +49,12 @@ mod laser_models;
 mod output;
 mod planner;
 mod presets;
+mod realistic_laser;
+mod realistic_presets;
+mod realistic_worlds;
 mod robot_classes;
 mod simulation;
+mod surfaces;
 mod truth;
 mod world;
 mod world_presets;
@@ -64,7 +73,10 @@ pub use presets::{
     simulate_table_row, table_row_config, PresetRegistry, TableRow, BUILTIN_PRESETS,
     SECONDS_PER_SAMPLE,
 };
+pub use realistic_laser::RealisticLaser;
+pub use realistic_presets::REALISTIC_PRESETS;
 pub use simulation::{simulate, simulate_in, SimEncoderRecord, SimRun, SimScan};
+pub use surfaces::{Hit, Scene, Surface, Walker};
 pub use truth::{GroundTruth, TruthFaults, TruthScan, TruthSlip, TRUTH_FORMAT};
 pub use world::{Segment, World};
 pub use world_presets::WORLD_NAMES;

@@ -21,8 +21,9 @@ use odocal_geom::{FlatParams, Pose2};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
-/// The built-in preset names.
-pub const BUILTIN_PRESETS: [&str; 9] = [
+/// The built-in preset names (the last three with the realistic laser in cluttered
+/// worlds: [`crate::REALISTIC_PRESETS`]).
+pub const BUILTIN_PRESETS: [&str; 12] = [
     "khepera",
     "turtlebot",
     "pioneer",
@@ -32,6 +33,9 @@ pub const BUILTIN_PRESETS: [&str; 9] = [
     "straight-only",
     "spin-only",
     "identical-turns",
+    "mines-rover",
+    "neato-lds",
+    "turtlebot4-rplidar",
 ];
 
 /// Seconds of driving per calibration sample: the calibration pipeline's default
@@ -267,7 +271,7 @@ fn builtin(name: &str) -> Option<SimConfig> {
         "identical-turns" => c.trajectory = TrajectoryKind::IdenticalTurns,
         "turtlebot" => return Some(robot_classes::turtlebot(c)),
         "pioneer" => return Some(robot_classes::pioneer(c)),
-        _ => return None,
+        _ => return crate::realistic_presets::preset(name, c),
     }
     // The Khepera presets keep the instantaneous URG-04LX of the logs they reproduce.
     debug_assert_eq!(c.laser, LaserConfig::default());

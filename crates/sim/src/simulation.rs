@@ -70,6 +70,10 @@ pub struct SimScan {
     pub sensor: Pose2,
     /// True sensor pose when the last ray was taken (equal to `sensor` without sweep).
     pub sensor_at_last_ray: Pose2,
+    /// True sensor pose at the middle of the sweep, the time the scan stands for once
+    /// its sweep is compensated (`timestamp + (n − 1) · time_increment / 2`; equal to
+    /// `sensor` without sweep): the truth a compensated match is compared with.
+    pub sensor_at_reference: Pose2,
     /// True cumulative wheel rotations `[left, right]` (rad) at acquisition.
     pub wheel_angles: [f64; 2],
     /// The readings (m), 0 for failures.
@@ -240,14 +244,23 @@ pub fn simulate_in(config: &SimConfig, world: &World) -> Result<SimRun, SimError
             while si < scan_times.len() && scan_times[si] < t1 {
                 let s = drive.state_at_us(scan_times[si]);
                 let sensor = s.pose.compose(&c.robot.laser);
+                let ranges = match &c.laser.realism {
+                    None => c.laser.scan(world, &sensor, &mut noise),
+                    Some(r) => {
+                        let elapsed = scan_times[si] as f64 * 1e-6;
+                        c.laser
+                            .realistic_scan(r, world, &[sensor], elapsed, &mut noise)
+                    }
+                };
                 scans.push(SimScan {
                     t: timestamp(start_us + scan_times[si] as i64 + offset_us),
                     t_true: timestamp(start_us + scan_times[si] as i64),
                     robot: s.pose,
                     sensor,
                     sensor_at_last_ray: sensor,
+                    sensor_at_reference: sensor,
                     wheel_angles: s.wheel_angles,
-                    ranges: c.laser.scan(world, &sensor, &mut noise),
+                    ranges,
                     dropped: is_dropped(&mut drops),
                 });
                 si += 1;
@@ -268,14 +281,23 @@ pub fn simulate_in(config: &SimConfig, world: &World) -> Result<SimRun, SimError
                     break;
                 };
                 let first = sweep.first.unwrap_or_else(|| drive.current());
+                let ranges = match &c.laser.realism {
+                    None => c.laser.swept_scan(world, &sweep.sensor_poses, &mut noise),
+                    Some(r) => {
+                        let elapsed = sweep.start_us as f64 * 1e-6;
+                        c.laser
+                            .realistic_scan(r, world, &sweep.sensor_poses, elapsed, &mut noise)
+                    }
+                };
                 scans.push(SimScan {
                     t: timestamp(start_us + sweep.start_us as i64 + offset_us),
                     t_true: timestamp(start_us + sweep.start_us as i64),
                     robot: first.pose,
                     sensor: sweep.sensor_poses[0],
                     sensor_at_last_ray: sweep.sensor_poses[c.laser.num_rays - 1],
+                    sensor_at_reference: sweep.reference.unwrap_or(sweep.sensor_poses[0]),
                     wheel_angles: first.wheel_angles,
-                    ranges: c.laser.swept_scan(world, &sweep.sensor_poses, &mut noise),
+                    ranges,
                     dropped: sweep.dropped,
                 });
             }
@@ -302,6 +324,8 @@ struct Sweep {
     first: Option<DriveState>,
     /// Sensor pose (world) at each ray fired so far.
     sensor_poses: Vec<Pose2>,
+    /// Sensor pose at the middle of the sweep, once reached.
+    reference: Option<Pose2>,
     /// Left out of the log by the drop fault (drawn when the sweep starts, so that the
     /// drop pattern does not depend on the sweep).
     dropped: bool,
@@ -313,6 +337,7 @@ impl Sweep {
             start_us,
             first: None,
             sensor_poses: Vec::new(),
+            reference: None,
             dropped,
         }
     }
@@ -320,6 +345,11 @@ impl Sweep {
     /// Fires the rays due before `end_us` (the end of the drive's current sub-step).
     fn fire_rays_before(&mut self, end_us: u64, drive: &Drive, c: &SimConfig) {
         let increment_us = c.laser.time_increment * 1e6;
+        let middle = self.start_us as f64 + 0.5 * c.laser.sweep_duration() * 1e6;
+        if self.reference.is_none() && middle < end_us as f64 {
+            let t = middle.max(drive.step_start_us() as f64);
+            self.reference = Some(drive.state_at_fractional_us(t).pose.compose(&c.robot.laser));
+        }
         while self.sensor_poses.len() < c.laser.num_rays {
             let t = self.start_us as f64 + self.sensor_poses.len() as f64 * increment_us;
             if t >= end_us as f64 {

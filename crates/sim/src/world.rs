@@ -1,6 +1,7 @@
 //! A world made of line segments (walls, obstacle edges), with ray casting and the
 //! clearance queries the trajectory planner uses to keep the robot off the walls.
 
+use crate::surfaces::{Surface, Walker};
 use serde::{Deserialize, Serialize};
 
 /// A wall: the straight segment from `a` to `b` (m, world frame).
@@ -72,6 +73,13 @@ pub struct World {
     bounds: [f64; 4],
     /// A point known to be in the free space where the robot drives.
     home: [f64; 2],
+    /// What each segment is made of, by segment index (see [`World::with_surfaces`]);
+    /// empty (every segment a matte wall) in the plain worlds.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    surfaces: Vec<Surface>,
+    /// People walking about (see [`World::with_walkers`]); none in the plain worlds.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    walkers: Vec<Walker>,
 }
 
 impl World {
@@ -100,6 +108,8 @@ impl World {
             segments,
             bounds,
             home,
+            surfaces: Vec::new(),
+            walkers: Vec::new(),
         }
     }
 
@@ -124,6 +134,23 @@ impl World {
     /// All wall segments.
     pub fn segments(&self) -> &[Segment] {
         &self.segments
+    }
+
+    /// The people walking in the world (see [`World::with_walkers`]).
+    pub fn walkers(&self) -> &[Walker] {
+        &self.walkers
+    }
+
+    pub(crate) fn surface_list(&self) -> &[Surface] {
+        &self.surfaces
+    }
+
+    pub(crate) fn set_surfaces(&mut self, surfaces: Vec<Surface>) {
+        self.surfaces = surfaces;
+    }
+
+    pub(crate) fn set_walkers(&mut self, walkers: Vec<Walker>) {
+        self.walkers = walkers;
     }
 
     /// Bounding box of the walls: `[min_x, min_y, max_x, max_y]` (m).

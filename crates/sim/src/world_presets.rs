@@ -5,16 +5,26 @@ use crate::error::SimError;
 use crate::world::{Segment, World};
 
 /// Names accepted by [`World::preset`].
-pub const WORLD_NAMES: [&str; 4] = ["khepera-arena", "office", "corridor", "hall"];
+pub const WORLD_NAMES: [&str; 6] = [
+    "khepera-arena",
+    "office",
+    "corridor",
+    "hall",
+    "office-cluttered",
+    "hall-cluttered",
+];
 
 impl World {
-    /// A preset world by name: `khepera-arena`, `office`, `corridor` or `hall`.
+    /// A preset world by name: `khepera-arena`, `office`, `corridor`, `hall`, or the
+    /// realistic `office-cluttered` and `hall-cluttered`.
     pub fn preset(name: &str) -> Result<World, SimError> {
         match name {
             "khepera-arena" | "arena" | "khepera_arena" => Ok(World::khepera_arena()),
             "office" => Ok(World::office()),
             "corridor" => Ok(World::corridor()),
             "hall" | "warehouse" => Ok(World::hall()),
+            "office-cluttered" => Ok(World::office_cluttered()),
+            "hall-cluttered" => Ok(World::hall_cluttered()),
             _ => Err(SimError::UnknownName {
                 what: "world",
                 name: name.to_string(),

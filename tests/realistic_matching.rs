@@ -1,0 +1,396 @@
+//! The scan matcher on the realistic presets (docs/realistic-presets.md), measured
+//! against the simulator's truth: the share of the pairs whose true overlap is at
+//! least half the scan that the pipeline matches, and the error of every accepted
+//! match against the true displacement of the sensor.
+//!
+//! The fast tests (20 s logs) assert what today's matcher reaches, with a margin.
+//! The table, on longer logs and several seeds:
+//! `cargo test --release --test realistic_matching -- --ignored --nocapture`.
+
+use odocal_geom::Pose2;
+use odocal_pipeline::{synchronize_and_match, NoProgress, Options, Timing};
+use odocal_sim::{simulate_in, RealisticLaser, SimConfig, SimRun, World, REALISTIC_PRESETS};
+use std::collections::BTreeMap;
+
+/// Accepted matches farther than this from the truth are wrong (m, rad).
+const MAX_ERROR_M: f64 = 0.005;
+const MAX_ERROR_RAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
+/// A scan point of the second scan counts as seen by the first when the first's ray
+/// toward it reaches it within this (m).
+const VISIBLE_TOLERANCE_M: f64 = 0.05;
+
+/// What the matcher did on one log.
+#[derive(Debug, Default, Clone)]
+struct Yield {
+    /// Pairs sent to the matcher (not discarded for wheel reasons).
+    tried: usize,
+    /// Of those, pairs whose true overlap is at least half the second scan.
+    overlapping: usize,
+    /// Of the overlapping pairs, those matched.
+    overlapping_matched: usize,
+    /// All accepted matches, and their errors against the truth (m, rad).
+    errors: Vec<(f64, f64)>,
+    /// The matcher's rejections, by reason.
+    rejections: BTreeMap<&'static str, usize>,
+}
+
+impl Yield {
+    fn add(&mut self, other: &Yield) {
+        self.tried += other.tried;
+        self.overlapping += other.overlapping;
+        self.overlapping_matched += other.overlapping_matched;
+        self.errors.extend_from_slice(&other.errors);
+        for (k, v) in &other.rejections {
+            *self.rejections.entry(k).or_default() += v;
+        }
+    }
+
+    /// Share of the overlapping pairs matched.
+    fn share(&self) -> f64 {
+        self.overlapping_matched as f64 / self.overlapping.max(1) as f64
+    }
+
+    /// Accepted matches beyond 5 mm or 0.5° of the truth.
+    fn wrong(&self) -> usize {
+        self.errors
+            .iter()
+            .filter(|(d, a)| *d > MAX_ERROR_M || *a > MAX_ERROR_RAD)
+            .count()
+    }
+
+    /// RMS translation (mm) and rotation (°) error of the accepted matches.
+    fn rms(&self) -> (f64, f64) {
+        let n = self.errors.len().max(1) as f64;
+        let d = self.errors.iter().map(|(d, _)| d * d).sum::<f64>() / n;
+        let a = self.errors.iter().map(|(_, a)| a * a).sum::<f64>() / n;
+        (d.sqrt() * 1e3, a.sqrt().to_degrees())
+    }
+
+    /// Largest translation (mm) and rotation (°) error.
+    fn worst(&self) -> (f64, f64) {
+        let d = self.errors.iter().map(|e| e.0).fold(0.0, f64::max);
+        let a = self.errors.iter().map(|e| e.1).fold(0.0, f64::max);
+        (d * 1e3, a.to_degrees())
+    }
+
+    fn row(&self, label: &str) -> String {
+        let (rd, ra) = self.rms();
+        let (wd, wa) = self.worst();
+        let reasons: Vec<String> = self
+            .rejections
+            .iter()
+            .filter(|(_, n)| **n > 0)
+            .map(|(k, n)| format!("{k} {n}"))
+            .collect();
+        format!(
+            "| {label} | {} | {} | {}/{} ({:.0} %) | {} | {rd:.1} mm / {ra:.2}° | {wd:.1} mm / {wa:.2}° | {} ({:.0} %) | {} |",
+            self.tried,
+            self.overlapping,
+            self.overlapping_matched,
+            self.overlapping,
+            100.0 * self.share(),
+            self.errors.len(),
+            self.wrong(),
+            100.0 * self.wrong() as f64 / self.errors.len().max(1) as f64,
+            reasons.join(", ")
+        )
+    }
+}
+
+const TABLE_HEADER: &str = "| preset, seeds | pairs tried | true overlap ≥ ½ | matched of those | accepted | RMS error | worst error | beyond 5 mm / 0.5° | rejections |\n|---|---|---|---|---|---|---|---|---|";
+
+/// The share of the returns of `second` (taken from `p2`) that the sensor at `p1` sees
+/// too: the ray from `p1` toward each point reaches it (nothing nearer in between,
+/// within the range and the field of view).
+fn true_overlap(run: &SimRun, p1: &Pose2, p2: &Pose2, second: &[f32]) -> f64 {
+    let laser = &run.config.laser;
+    let angles = laser.angles();
+    let (lo, hi) = {
+        let (a, b) = (angles[0], angles[angles.len() - 1]);
+        (a.min(b), a.max(b))
+    };
+    let full_turn = hi - lo + laser.resolution.abs() >= std::f64::consts::TAU - 1e-9;
+    let world: &World = &run.world;
+    let (mut seen, mut valid) = (0usize, 0usize);
+    for (&r, &a) in second.iter().zip(&angles) {
+        if r <= 0.0 {
+            continue;
+        }
+        valid += 1;
+        let r = r as f64;
+        let (s, c) = (p2.theta + a).sin_cos();
+        let q = [p2.x + r * c, p2.y + r * s];
+        let (dx, dy) = (q[0] - p1.x, q[1] - p1.y);
+        let dist = dx.hypot(dy);
+        if dist >= laser.max_range || dist <= laser.min_range {
+            continue;
+        }
+        let bearing = odocal_geom::wrap_angle(dy.atan2(dx) - p1.theta);
+        if !full_turn && (bearing < lo || bearing > hi) {
+            continue;
+        }
+        let reach = world
+            .cast_ray([p1.x, p1.y], dy.atan2(dx), laser.max_range)
+            .unwrap_or(f64::INFINITY);
+        if reach >= dist - VISIBLE_TOLERANCE_M {
+            seen += 1;
+        }
+    }
+    seen as f64 / valid.max(1) as f64
+}
+
+/// Simulates `preset` for `duration` s with `seed`, runs the pipeline's
+/// synchronization and matching on it, and compares with the truth.
+fn measure(preset: &str, seed: u64, duration: f64) -> Yield {
+    let mut config = SimConfig::preset(preset).unwrap();
+    config.seed = seed;
+    config.duration = duration;
+    measure_config(config)
+}
+
+/// [`measure`] on the configuration `config`.
+fn measure_config(config: SimConfig) -> Yield {
+    let world = World::preset(&config.world).unwrap();
+    measure_in(config, &world)
+}
+
+/// [`measure`] on the configuration `config` in `world`.
+fn measure_in(config: SimConfig, world: &World) -> Yield {
+    let run = simulate_in(&config, world).unwrap();
+    let log = run.to_log();
+    let mut timing = Timing::default();
+    let synced =
+        synchronize_and_match(&log, &Options::default(), &NoProgress, &mut timing).unwrap();
+    let scans: Vec<_> = run.logged_scans().collect();
+    let truth_pose = |i: usize| {
+        if synced.sweep_compensated {
+            scans[i].sensor_at_reference
+        } else {
+            scans[i].sensor
+        }
+    };
+    let matched: BTreeMap<(usize, usize), Pose2> = synced
+        .samples
+        .iter()
+        .map(|s| ((s.pair.first, s.pair.second), s.icp.pose))
+        .collect();
+    let discarded_other = synced.discarded.0.values().sum::<usize>()
+        - synced.discarded.0.get("match_failed").copied().unwrap_or(0);
+    let mut y = Yield {
+        tried: synced.pairs - discarded_other,
+        rejections: synced.match_rejections.0.clone(),
+        ..Yield::default()
+    };
+    let k = synced.stride;
+    let mut i = 0;
+    let mut overlapping_pairs = 0;
+    while i + k < scans.len() {
+        let (a, b) = (truth_pose(i), truth_pose(i + k));
+        let overlap = true_overlap(&run, &a, &b, &scans[i + k].ranges);
+        let accepted = matched.get(&(i, i + k));
+        if overlap >= 0.5 {
+            overlapping_pairs += 1;
+            if accepted.is_some() {
+                y.overlapping_matched += 1;
+            }
+        }
+        if let Some(pose) = accepted {
+            let truth = a.inverse().compose(&b);
+            let e = truth.inverse().compose(pose);
+            y.errors
+                .push((e.x.hypot(e.y), odocal_geom::wrap_angle(e.theta).abs()));
+        }
+        i += k;
+    }
+    // Pairs discarded for wheel reasons (robot still, encoder gaps) never reach the
+    // matcher; they are counted out of the overlapping ones (a still robot's pair
+    // overlaps fully).
+    y.overlapping = overlapping_pairs - discarded_other.min(overlapping_pairs);
+    y
+}
+
+fn print_rows(preset: &str, seeds: &[u64], duration: f64) -> Yield {
+    let mut total = Yield::default();
+    for &seed in seeds {
+        let y = measure(preset, seed, duration);
+        println!("{}", y.row(&format!("{preset} seed {seed}")));
+        total.add(&y);
+    }
+    total
+}
+
+/// The fast check of one preset: the share matched at least `min_share`, and no
+/// accepted match beyond 5 mm / 0.5° of the truth.
+fn check(preset: &str, min_share: f64) {
+    let y = measure(preset, 1, 20.0);
+    println!("{TABLE_HEADER}\n{}", y.row(preset));
+    assert!(
+        y.overlapping >= 10,
+        "{preset}: {} overlapping pairs",
+        y.overlapping
+    );
+    assert!(
+        y.share() >= min_share,
+        "{preset}: {:.2} of the overlapping pairs matched",
+        y.share()
+    );
+    assert_eq!(
+        y.wrong(),
+        0,
+        "{preset}: accepted matches beyond 5 mm / 0.5°"
+    );
+}
+
+// Today's matcher (main at 4d58c6a) accepts matches beyond 5 mm / 0.5° of the truth on
+// mines-rover and turtlebot4-rplidar (15 of 28 and 16 of 33 accepted matches on these
+// 20 s logs; the table in docs/benchmarks.md), so their tests fail on the last
+// assertion and are ignored until the matcher work (issue 20 item 2) lands. The
+// shares asserted are today's (61 %, 66 %) less a margin.
+
+#[test]
+#[ignore = "today's matcher accepts matches beyond 5 mm / 0.5° here (docs/benchmarks.md)"]
+fn mines_rover_matches_without_wrong_matches() {
+    check("mines-rover", 0.45);
+}
+
+/// Today's matcher matches none of the Neato's sparse scans (too few correspondences,
+/// residuals above its noise test), so it accepts no wrong one either: the share
+/// asserted is 0 until the matcher work lands; a wrong match accepted fails.
+#[test]
+fn neato_lds_matches_without_wrong_matches() {
+    check("neato-lds", 0.0);
+}
+
+#[test]
+#[ignore = "today's matcher accepts matches beyond 5 mm / 0.5° here (docs/benchmarks.md)"]
+fn turtlebot4_rplidar_matches_without_wrong_matches() {
+    check("turtlebot4-rplidar", 0.5);
+}
+
+/// The measurement itself sees what it should: on clean presets with a sweeping
+/// laser (`pioneer`: a URG-04LX in the plain hall; `turtlebot`: an LDS in the plain
+/// office) nearly every pair overlaps, most are matched (the hall's pairs refused
+/// are ill-conditioned ones, 8 of 46), and every accepted match is within 5 mm /
+/// 0.5° of the truth (RMS 1.2 and 1.7 mm): the truth compared with is right.
+#[test]
+fn measurement_finds_the_clean_presets_clean() {
+    for (preset, min_share) in [("pioneer", 0.75), ("turtlebot", 0.9)] {
+        let y = measure(preset, 1, 20.0);
+        println!("{TABLE_HEADER}\n{}", y.row(preset));
+        assert!(
+            y.overlapping as f64 >= 0.9 * y.tried as f64,
+            "{preset}: {y:?}"
+        );
+        assert!(y.share() >= min_share, "{preset}: {:.2}", y.share());
+        assert_eq!(y.wrong(), 0, "{preset}: {:?}", y.worst());
+        assert!(y.rms().0 < 2.5, "{preset}: {:?}", y.rms());
+    }
+}
+
+/// The table of docs/benchmarks.md: 120 s of each realistic preset, three seeds.
+#[test]
+#[ignore = "heavy (about 20 s): prints the table of docs/benchmarks.md"]
+fn realistic_presets_match_table() {
+    println!("{TABLE_HEADER}");
+    for preset in REALISTIC_PRESETS {
+        let total = print_rows(preset, &[1, 2, 3], 120.0);
+        println!("{}", total.row(&format!("**{preset}, 3 seeds**")));
+    }
+}
+
+/// Which effect of the realistic mode does what to the matcher: each preset (20 s,
+/// seed 1) as is, then with one effect taken out, then with only one kept.
+#[test]
+#[ignore = "diagnostic for the matcher work: prints the ablation table of docs/benchmarks.md"]
+fn realistic_effects_ablation() {
+    type Change = fn(&mut SimConfig, &mut World);
+    fn realism(c: &mut SimConfig) -> &mut RealisticLaser {
+        c.laser.realism.as_mut().expect("a realistic preset")
+    }
+    fn plain_world(c: &mut SimConfig, w: &mut World) {
+        let plain = if w.name().starts_with("hall") {
+            "hall"
+        } else {
+            "office"
+        };
+        *w = World::preset(plain).unwrap();
+        c.world = plain.into();
+    }
+    fn no_fading(c: &mut SimConfig) {
+        realism(c).half_return_range = 1e3;
+        realism(c).grazing_angle = 1.5;
+    }
+    fn no_systematic(c: &mut SimConfig) {
+        let r = realism(c);
+        (r.bias_offset, r.bias_quadratic, r.drift) = (0.0, 0.0, 0.0);
+    }
+    let variants: [(&str, Change); 9] = [
+        ("as is", |_, _| {}),
+        ("plain laser (no realism, no people, no glass)", |c, _| {
+            c.laser.realism = None
+        }),
+        ("no people", |_, w| *w = w.clone().with_walkers(vec![])),
+        ("plain world (no clutter, glass, people)", plain_world),
+        ("no bias, no drift", |c, _| no_systematic(c)),
+        ("no mixed pixels", |c, _| {
+            realism(c).mixed_pixel_probability = 0.0
+        }),
+        ("no noise growth with range", |c, _| {
+            realism(c).sigma_per_metre = 0.0
+        }),
+        ("no fading with range and incidence", |c, _| no_fading(c)),
+        ("only noise growth (plain world)", |c, w| {
+            no_fading(c);
+            no_systematic(c);
+            realism(c).mixed_pixel_probability = 0.0;
+            plain_world(c, w);
+        }),
+    ];
+    println!("{TABLE_HEADER}");
+    for preset in REALISTIC_PRESETS {
+        for (label, change) in variants {
+            let mut config = SimConfig::preset(preset).unwrap();
+            config.duration = 20.0;
+            let mut world = World::preset(&config.world).unwrap();
+            change(&mut config, &mut world);
+            let y = measure_in(config, &world);
+            println!("{}", y.row(&format!("{preset}: {label}")));
+        }
+    }
+}
+
+/// The realistic presets are on the command line: listed, and simulated with their
+/// truth file (which names the realistic laser and the cluttered world).
+#[test]
+fn realistic_presets_are_on_the_command_line() {
+    let odocal = env!("CARGO_BIN_EXE_odocal");
+    let out = std::process::Command::new(odocal)
+        .args(["simulate", "--list-presets"])
+        .output()
+        .expect("run odocal");
+    let listed = String::from_utf8_lossy(&out.stdout);
+    let dir = std::env::temp_dir().join(format!("odocal-realistic-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    for preset in REALISTIC_PRESETS {
+        assert!(
+            listed.lines().any(|l| l == preset),
+            "{preset} not in\n{listed}"
+        );
+        let prefix = dir.join(preset);
+        let out = std::process::Command::new(odocal)
+            .args(["simulate", "--preset", preset, "--duration", "2", "--out"])
+            .arg(&prefix)
+            .output()
+            .expect("run odocal");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let truth = std::fs::read_to_string(prefix.with_extension("truth.json")).unwrap();
+        let truth: serde_json::Value = serde_json::from_str(&truth).unwrap();
+        assert!(truth["config"]["laser"]["realism"].is_object(), "{preset}");
+        assert!(truth["world"].as_str().unwrap().ends_with("-cluttered"));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
