@@ -9,6 +9,7 @@ use crate::options::Options;
 use crate::sync::EncoderTrack;
 use crate::synchronized::Synchronized;
 use odocal_log::Log;
+use rayon::prelude::*;
 
 /// Half-width (s) of the quick check's search around the offset in use.
 pub const QUICK_RANGE_S: f64 = 2.0;
@@ -79,7 +80,9 @@ pub fn quick_estimate(
             .collect()
     };
     let n = (range / QUICK_STEP_S).round() as i64;
+    // The grid points are independent: evaluated in parallel, in order.
     let grid: Vec<(f64, f64)> = (-n..=n)
+        .into_par_iter()
         .filter_map(|i| {
             let d = center + i as f64 * QUICK_STEP_S;
             let c = correlation(&theta, &rotation_at(d)?);
