@@ -34,6 +34,9 @@ pub struct MatchSelfCheck {
     pub theta_rad: f64,
     /// The median range noise of the log's scans (m), for scale.
     pub range_noise_m: f64,
+    /// The factor by which this error multiplied the solver's σ (1: the residuals'
+    /// noise already covered it; see [`crate::match_quality::sigma_inflation`]).
+    pub sigma_factor: f64,
 }
 
 /// Measures the matcher's error on `samples` (in time order) with the scans they
@@ -90,5 +93,6 @@ pub fn closure_check(
         xy_m: (sum_xy / (2.0 * 3.0 * n_f)).sqrt(),
         theta_rad: (sum_theta / (3.0 * n_f)).sqrt(),
         range_noise_m,
+        sigma_factor: 1.0,
     })
 }
