@@ -380,7 +380,10 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
     let mut calibration = odocal_solver::calibrate(&samples, &solve_options)?;
     if let Some(check) = &synced.match_self_check {
         // The matcher's own error, when larger than the residuals' noise, scales σ.
-        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
+        let factor = crate::match_quality::sigma_inflation(
+            check,
+            crate::match_quality::own_sigma(&calibration),
+        );
         odocal_solver::inflate_sigma(&mut calibration, factor);
     }
     refuse_poorly_determined(calibration, synced, &samples, &solve_options, opts)
@@ -579,7 +582,10 @@ pub fn calibrate_log(
     let t = Instant::now();
     let calibration = solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
     if let Some(check) = synced.match_self_check.as_mut() {
-        check.sigma_factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
+        check.sigma_factor = crate::match_quality::sigma_inflation(
+            check,
+            crate::match_quality::own_sigma(&calibration),
+        );
     }
     timing.solve += t.elapsed().as_secs_f64();
 

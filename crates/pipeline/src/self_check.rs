@@ -34,8 +34,8 @@ pub struct MatchSelfCheck {
     pub theta_rad: f64,
     /// The median range noise of the log's scans (m), for scale.
     pub range_noise_m: f64,
-    /// The factor by which this error multiplied the solver's σ (1: the residuals'
-    /// noise already covered it; see [`crate::match_quality::sigma_inflation`]).
+    /// The factor by which this error multiplied the solver's σ (1: the noise model
+    /// already covered it; see [`crate::match_quality::sigma_inflation`]).
     pub sigma_factor: f64,
 }
 
