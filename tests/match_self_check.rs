@@ -68,3 +68,41 @@ fn clean_logs_keep_their_verdicts_and_sigma() {
     );
     assert!(!obs.sentence.contains("scan matching"), "{}", obs.sentence);
 }
+
+#[test]
+fn matcher_error_beyond_the_noise_model_scales_sigma() {
+    // Range noise correlated over 10 rays: the matcher's error per pair (closure of
+    // scan triples) is 1.4× the noise model's own part per sample on this seed.
+    let mut config = SimConfig::preset("khepera").expect("preset");
+    config.seed = 7;
+    config.duration = 120.0;
+    config.laser.range_sigma = 0.01;
+    config.laser.correlation_rays = 10;
+    let log = simulate(&config).expect("simulation runs").to_log();
+    let opts = Options {
+        accept_weak: true,
+        ..Options::default()
+    };
+    let out = calibrate_log(&log, &opts, &NoProgress).expect("calibrates");
+    let check = out.synced.match_self_check.expect("triples close");
+    assert!(check.sigma_factor > 1.26, "{check:?}");
+    // The solver alone, on the same samples: σ smaller by the factor.
+    let samples: Vec<_> = out
+        .synced
+        .samples
+        .iter()
+        .map(|s| odocal_solver::Sample {
+            read_time_sigma: out.synced.read_time_sigma,
+            ..s.to_solver(opts.use_profile, opts.use_icp_covariance)
+        })
+        .collect();
+    let alone = odocal_solver::calibrate(&samples, &opts.solve_options()).expect("solves");
+    for i in 0..6 {
+        let ratio = (out.calibration.covariance[i][i] / alone.covariance[i][i]).sqrt();
+        assert!(
+            (ratio - check.sigma_factor).abs() < 1e-9 * check.sigma_factor,
+            "parameter {i}: σ ratio {ratio}, factor {}",
+            check.sigma_factor
+        );
+    }
+}
