@@ -194,6 +194,7 @@ mod tests {
             xy_m,
             theta_rad,
             range_noise_m: 0.001,
+            sigma_factor: 1.0,
         }
     }
 

@@ -283,11 +283,24 @@ impl<'a> EncoderTrack<'a> {
     /// Index `i` of the records bracketing `t`: `records[i-1].t ≤ t < records[i].t`
     /// (or `t` equal to the last record's time, bracketed by the last two).
     fn bracket(&self, t: f64, max_gap: f64) -> Result<usize, DiscardReason> {
+        self.bracket_near(t, max_gap, 0)
+    }
+
+    /// [`EncoderTrack::bracket`], trying first the index `hint` and its neighbours
+    /// (the answer for a nearby instant) before a binary search; the same answer.
+    fn bracket_near(&self, t: f64, max_gap: f64, hint: usize) -> Result<usize, DiscardReason> {
         let n = self.records.len();
         if n < 2 || !t.is_finite() {
             return Err(DiscardReason::EncoderGap);
         }
-        let mut i = self.records.partition_point(|r| r.t <= t);
+        // Records sorted by time: `records[j-1].t ≤ t < records[j].t` makes `j` the
+        // partition point.
+        let brackets =
+            |j: usize| j >= 1 && j < n && self.records[j - 1].t <= t && t < self.records[j].t;
+        let mut i = [hint, hint.wrapping_sub(1), hint + 1]
+            .into_iter()
+            .find(|&j| brackets(j))
+            .unwrap_or_else(|| self.records.partition_point(|r| r.t <= t));
         if i == n && self.records[n - 1].t == t {
             i = n - 1;
         }
@@ -357,6 +370,20 @@ impl<'a> EncoderTrack<'a> {
     /// or why they are not known well enough.
     pub fn ticks_at(&self, t: f64, max_gap: f64) -> Result<(f64, f64), DiscardReason> {
         let i = self.bracket(t, max_gap)?;
+        Ok(self.ticks_between(i, t))
+    }
+
+    /// [`EncoderTrack::ticks_at`] for a run of nearby instants: `hint` holds the
+    /// record index found for the previous one (start with 0) and is updated. The
+    /// same values, without a binary search per instant.
+    pub fn ticks_at_near(
+        &self,
+        t: f64,
+        max_gap: f64,
+        hint: &mut usize,
+    ) -> Result<(f64, f64), DiscardReason> {
+        let i = self.bracket_near(t, max_gap, *hint)?;
+        *hint = i;
         Ok(self.ticks_between(i, t))
     }
 
@@ -466,6 +493,34 @@ mod tests {
         assert_eq!(idx, vec![(0, 3), (3, 6), (6, 9)]);
         assert_eq!(scan_pairs(&t, 1).len(), 9);
         assert!(scan_pairs(&t[..1], 1).is_empty());
+    }
+
+    #[test]
+    fn ticks_near_a_hint_are_the_ticks_at_the_instant() {
+        // Irregular records with a repeated timestamp; instants walked both ways in
+        // steps shorter and longer than the records' spacing, from stale hints too,
+        // and beyond both ends.
+        let mut recs: Vec<EncoderRecord> = (0..60)
+            .map(|k| rec(k as f64 * 0.02 + 0.003 * (k % 3) as f64, 7 * k * k, -5 * k))
+            .collect();
+        recs[30].t = recs[29].t;
+        let track = EncoderTrack::new(&recs, 100.0);
+        for step in [0.004, 0.01, 0.03, -0.01, -0.05] {
+            for start_hint in [0, 17, 59, 200] {
+                let mut hint = start_hint;
+                for k in 0..400 {
+                    let t = if step > 0.0 { -0.1 } else { 1.3 } + step * k as f64;
+                    for gap in [0.05, f64::INFINITY] {
+                        let mut h = hint;
+                        let near = track.ticks_at_near(t, gap, &mut h);
+                        assert_eq!(near, track.ticks_at(t, gap), "t {t}, gap {gap}");
+                        if gap.is_infinite() {
+                            hint = h;
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]
