@@ -131,10 +131,7 @@ pub fn calibrate_logs(
     let mut calibration = odocal_solver::calibrate(&samples, &solve_options)
         .map_err(|e| JointError::Joint(PipelineError::from(e).with_faults(&health)))?;
     if let Some(check) = &synced.match_self_check {
-        let factor = crate::match_quality::sigma_inflation(
-            check,
-            crate::match_quality::own_sigma(&calibration),
-        );
+        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
         odocal_solver::inflate_sigma(&mut calibration, factor);
     }
     let agreements: Vec<Consistency> = logs

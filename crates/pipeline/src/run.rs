@@ -380,10 +380,7 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
     let mut calibration = odocal_solver::calibrate(&samples, &solve_options)?;
     if let Some(check) = &synced.match_self_check {
         // The matcher's own error, when larger than the residuals' noise, scales σ.
-        let factor = crate::match_quality::sigma_inflation(
-            check,
-            crate::match_quality::own_sigma(&calibration),
-        );
+        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
         odocal_solver::inflate_sigma(&mut calibration, factor);
     }
     refuse_poorly_determined(calibration, synced, &samples, &solve_options, opts)
@@ -415,10 +412,10 @@ pub(crate) fn refuse_poorly_determined(
         .match_self_check
         .as_ref()
         .and_then(|c| crate::match_quality::judge(c, &synced.samples, synced.stride));
+    let mut demoted = Vec::new();
     if let Some(poor) = &poor_matching {
         // Matching errors comparable to the motion: the parameters determined from
         // that motion are not "well determined", whatever their σ.
-        let mut demoted = Vec::new();
         for &i in &poor.parameters {
             if let Some(p) = calibration.observability.parameters.get_mut(i) {
                 if p.verdict == Verdict::WellDetermined
@@ -464,10 +461,11 @@ pub(crate) fn refuse_poorly_determined(
                     None => refusal::causes(&calibration, synced),
                 },
                 // Holding parameters does not help against unrepaired timing, nor
-                // against matching errors comparable to the motion.
-                holds: match (&synced.unrepaired_timing, &poor_matching) {
-                    (Some(_), _) | (_, Some(_)) => Vec::new(),
-                    (None, None) => refusal::holds(
+                // against matching errors comparable to the motion (when they made
+                // parameters weak).
+                holds: match (&synced.unrepaired_timing, demoted.is_empty()) {
+                    (Some(_), _) | (None, false) => Vec::new(),
+                    (None, true) => refusal::holds(
                         samples,
                         solve_options,
                         &calibration,
@@ -582,10 +580,7 @@ pub fn calibrate_log(
     let t = Instant::now();
     let calibration = solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
     if let Some(check) = synced.match_self_check.as_mut() {
-        check.sigma_factor = crate::match_quality::sigma_inflation(
-            check,
-            crate::match_quality::own_sigma(&calibration),
-        );
+        check.sigma_factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
     }
     timing.solve += t.elapsed().as_secs_f64();
 
