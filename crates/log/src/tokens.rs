@@ -1,7 +1,7 @@
 //! Splitting a log line into tokens and reading typed fields from them, without
 //! allocating unless there is an error to report.
 
-use crate::number::{f32_of_token, parse_f64, parse_i64};
+use crate::number::{f32_of_token, parse_f64, parse_i64, DecimalSplit};
 
 /// The largest count of readings (or remissions) one line may announce.
 pub const MAX_COUNT: usize = 200_000;
@@ -28,7 +28,7 @@ impl<'a> Tokens<'a> {
     /// decimal (what [`crate::number::plain_decimal`] gives for it): range readings, most of a log's
     /// bytes, are read with one pass instead of two.
     #[inline]
-    pub(crate) fn next_decimal(&mut self) -> Option<(&'a [u8], Option<(bool, u64, usize)>)> {
+    pub(crate) fn next_decimal(&mut self) -> Option<(&'a [u8], Option<DecimalSplit>)> {
         let s = self.s;
         let mut i = self.i;
         while i < s.len() && is_separator(s[i]) {
