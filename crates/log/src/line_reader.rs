@@ -37,12 +37,12 @@ pub(crate) fn read_line<R: BufRead>(reader: &mut R, buf: &mut Vec<u8>) -> io::Re
         if chunk.is_empty() {
             break;
         }
-        let (take, done) = match chunk.iter().position(|&b| b == b'\n') {
+        let (take, done) = match memchr::memchr(b'\n', chunk) {
             Some(i) => (i + 1, true),
             None => (chunk.len(), false),
         };
         if nul.is_none() {
-            if let Some(i) = chunk[..take].iter().position(|&b| b == 0) {
+            if let Some(i) = memchr::memchr(0, &chunk[..take]) {
                 nul = Some(seen + i);
             }
         }

@@ -16,10 +16,13 @@ const POW10_F64: [f64; 23] = [
 /// Powers of ten exactly representable as `f32` (10^0 … 10^10).
 const POW10_F32: [f32; 11] = [1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10];
 
+/// A plain decimal split into (negative, mantissa, digits after the point).
+pub(crate) type DecimalSplit = (bool, u64, usize);
+
 /// Splits a plain decimal `[+-]digits[.digits]` into (negative, mantissa, digits after
 /// the point). `None` when the token is not of that form or has more than 19 digits.
 #[inline]
-fn plain_decimal(s: &[u8]) -> Option<(bool, u64, usize)> {
+pub(crate) fn plain_decimal(s: &[u8]) -> Option<DecimalSplit> {
     let (neg, body) = match s.first()? {
         b'-' => (true, &s[1..]),
         b'+' => (false, &s[1..]),
@@ -67,9 +70,17 @@ pub(crate) fn parse_f64(s: &[u8]) -> Option<f64> {
 }
 
 /// Parses a float token as `f32` (directly, not through `f64`, so that it rounds once).
-#[inline]
+/// (The reader takes the split from the tokenizer: [`f32_of_token`].)
+#[cfg(test)]
 pub(crate) fn parse_f32(s: &[u8]) -> Option<f32> {
-    if let Some((neg, m, k)) = plain_decimal(s) {
+    f32_of_token(s, plain_decimal(s))
+}
+
+/// The `f32` of token `s`, given its [`plain_decimal`] split (found while the token
+/// was delimited, by [`crate::tokens::Tokens::next_decimal`]).
+#[inline]
+pub(crate) fn f32_of_token(s: &[u8], plain: Option<DecimalSplit>) -> Option<f32> {
+    if let Some((neg, m, k)) = plain {
         if m < (1u64 << 24) && k < POW10_F32.len() {
             let v = m as f32 / POW10_F32[k];
             return Some(if neg { -v } else { v });

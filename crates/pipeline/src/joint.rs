@@ -128,8 +128,12 @@ pub fn calibrate_logs(
         }));
     }
     let solve_options = opts.solve_options();
-    let calibration = odocal_solver::calibrate(&samples, &solve_options)
+    let mut calibration = odocal_solver::calibrate(&samples, &solve_options)
         .map_err(|e| JointError::Joint(PipelineError::from(e).with_faults(&health)))?;
+    if let Some(check) = &synced.match_self_check {
+        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
+        odocal_solver::inflate_sigma(&mut calibration, factor);
+    }
     let agreements: Vec<Consistency> = logs
         .iter()
         .zip(&outcomes)
@@ -314,5 +318,6 @@ fn pooled_self_check(outcomes: &[Outcome]) -> Option<MatchSelfCheck> {
         xy_m: mean_square(|c| c.xy_m),
         theta_rad: mean_square(|c| c.theta_rad),
         range_noise_m: noise[noise.len() / 2],
+        sigma_factor: 1.0,
     })
 }

@@ -37,6 +37,7 @@ pub mod health;
 pub mod input_files;
 pub mod joint;
 pub mod log_agreement;
+pub mod match_quality;
 pub mod matching;
 pub mod options;
 pub mod parallel;

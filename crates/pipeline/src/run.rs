@@ -378,7 +378,12 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         })
         .collect();
     let solve_options = opts.solve_options();
-    let calibration = odocal_solver::calibrate(&samples, &solve_options)?;
+    let mut calibration = odocal_solver::calibrate(&samples, &solve_options)?;
+    if let Some(check) = &synced.match_self_check {
+        // The matcher's own error, when larger than the residuals' noise, scales σ.
+        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
+        odocal_solver::inflate_sigma(&mut calibration, factor);
+    }
     refuse_poorly_determined(calibration, synced, &samples, &solve_options, opts)
 }
 
@@ -412,6 +417,41 @@ pub(crate) fn refuse_poorly_determined(
         };
         calibration.observability.sentence = format!("{short}; {}", would_give(synced, &sentence));
     }
+    let poor_matching = synced
+        .match_self_check
+        .as_ref()
+        .and_then(|c| crate::match_quality::judge(c, &synced.samples, synced.stride));
+    let mut demoted = Vec::new();
+    if let Some(poor) = &poor_matching {
+        // Matching errors comparable to the motion: the parameters determined from
+        // that motion are not "well determined", whatever their σ.
+        for &i in &poor.parameters {
+            if let Some(p) = calibration.observability.parameters.get_mut(i) {
+                if p.verdict == Verdict::WellDetermined
+                    && !matches!(p.constraint, Constraint::Held(_))
+                {
+                    p.verdict = Verdict::Weak;
+                    demoted.push(p.name.clone());
+                }
+            }
+        }
+        if !demoted.is_empty() {
+            let obs = &mut calibration.observability;
+            obs.sentence = if obs
+                .sentence
+                .starts_with("all six parameters are well determined")
+            {
+                format!("{} weak: {}", demoted.join(", "), poor.statement)
+            } else {
+                format!(
+                    "{}; {} weak too: {}",
+                    obs.sentence,
+                    demoted.join(", "),
+                    poor.statement
+                )
+            };
+        }
+    }
     let poor: Vec<String> = calibration
         .observability
         .parameters
@@ -424,20 +464,23 @@ pub(crate) fn refuse_poorly_determined(
         // motion alone would give.
         let sentence = match &unjudgeable {
             Some(_) => would_give(synced, &sentence),
-            None => sentence,
+            None => calibration.observability.sentence.clone(),
         };
         return Err(PipelineError::NotDetermined {
             parameters: poor,
             sentence,
             diagnosis: Box::new(refusal::Diagnosis {
+                // Poor matching is named by the sentence (with its way out).
                 causes: match &unjudgeable {
                     Some(cause) => vec![cause.clone()],
                     None => refusal::causes(&calibration, synced),
                 },
-                // Holding parameters does not help against either.
-                holds: match unjudgeable {
-                    Some(_) => Vec::new(),
-                    None => refusal::holds(
+                // Holding parameters does not help against unrepaired timing or a
+                // heading not from the wheels, nor against matching errors comparable
+                // to the motion (when they made parameters weak).
+                holds: match (&unjudgeable, demoted.is_empty()) {
+                    (Some(_), _) | (None, false) => Vec::new(),
+                    (None, true) => refusal::holds(
                         samples,
                         solve_options,
                         &calibration,
@@ -564,6 +607,9 @@ pub fn calibrate_log(
     synced.heading_not_from_wheels = heading.as_ref().map(|fit| fit.cause());
     let t = Instant::now();
     let calibration = solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
+    if let Some(check) = synced.match_self_check.as_mut() {
+        check.sigma_factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
+    }
     timing.solve += t.elapsed().as_secs_f64();
     // Named in the findings only when the numbers are shown (--accept-weak): a
     // refusal names it as its cause.

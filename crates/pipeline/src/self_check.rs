@@ -34,6 +34,9 @@ pub struct MatchSelfCheck {
     pub theta_rad: f64,
     /// The median range noise of the log's scans (m), for scale.
     pub range_noise_m: f64,
+    /// The factor by which this error multiplied the solver's σ (1: the noise model
+    /// already covered it; see [`crate::match_quality::sigma_inflation`]).
+    pub sigma_factor: f64,
 }
 
 /// Measures the matcher's error on `samples` (in time order) with the scans they
@@ -59,7 +62,18 @@ pub fn closure_check(
         .map(|(ab, bc, _)| ab.pose.compose(&bc.pose))
         .collect();
     let pairs: Vec<(usize, usize)> = chosen.iter().map(|t| t.2).collect();
-    let direct = match_pairs(scans, &pairs, &chained, params, || {});
+    // The store's typical noise, estimated once: for the figure and for the matcher
+    // (which would otherwise estimate it again).
+    let range_noise_m = crate::matching::typical_noise_sigma(scans, params);
+    let params = IcpParams {
+        typical_noise_sigma: if params.typical_noise_sigma == 0.0 {
+            range_noise_m
+        } else {
+            params.typical_noise_sigma
+        },
+        ..params.clone()
+    };
+    let direct = match_pairs(scans, &pairs, &chained, &params, || {});
     let (mut sum_xy, mut sum_theta, mut n) = (0.0, 0.0, 0usize);
     for (d, c) in direct.iter().zip(&chained) {
         let Ok(d) = d else { continue };
@@ -78,6 +92,7 @@ pub fn closure_check(
         // Per axis: the sum over x and y is two axes; three matches per closure.
         xy_m: (sum_xy / (2.0 * 3.0 * n_f)).sqrt(),
         theta_rad: (sum_theta / (3.0 * n_f)).sqrt(),
-        range_noise_m: crate::matching::typical_noise_sigma(scans, params),
+        range_noise_m,
+        sigma_factor: 1.0,
     })
 }

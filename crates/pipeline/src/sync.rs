@@ -200,39 +200,79 @@ pub const MAX_PIECE_S: f64 = 0.025;
 /// would otherwise be cut into billions of pieces).
 pub const MAX_PIECES_PER_SPAN: usize = 64;
 
-/// The encoder stream, ready for interpolation.
-#[derive(Debug, Clone, Copy)]
+/// A count relative to `base`, exact while the difference is below 2^53 ticks
+/// (however large the counts themselves are).
+fn relative(count: i64, base: i64) -> f64 {
+    (i128::from(count) - i128::from(base)) as f64
+}
+
+/// The count rates (ticks/s, left and right) at record `k`: the three-point derivative
+/// from the two neighbouring records (the secant of the one segment at the ends of the
+/// stream or next to colliding timestamps).
+fn slope_at(records: &[EncoderRecord], k: usize) -> (f64, f64) {
+    let secant = |j: usize| -> Option<(f64, f64, f64)> {
+        let (p, q) = (records.get(j)?, records.get(j + 1)?);
+        let h = q.t - p.t;
+        (h > 0.0).then(|| {
+            (
+                h,
+                relative(q.left, p.left) / h,
+                relative(q.right, p.right) / h,
+            )
+        })
+    };
+    let before = k.checked_sub(1).and_then(secant);
+    match (before, secant(k)) {
+        (Some((h0, l0, r0)), Some((h1, l1, r1))) => (
+            (h1 * l0 + h0 * l1) / (h0 + h1),
+            (h1 * r0 + h0 * r1) / (h0 + h1),
+        ),
+        (Some((_, l, r)), None) | (None, Some((_, l, r))) => (l, r),
+        (None, None) => (0.0, 0.0),
+    }
+}
+
+/// The encoder stream, ready for interpolation: each record's counts relative to the
+/// first record's, and the count rates at each record, computed once (interpolating at
+/// an instant then costs a binary search and a cubic, not integer re-basing and two
+/// secants per call: the clock-offset check interpolates some 10⁶ times).
+#[derive(Debug, Clone)]
 pub struct EncoderTrack<'a> {
     records: &'a [EncoderRecord],
     rad_per_tick: f64,
-    /// The first record's counts: every count is taken relative to them, in integer
-    /// arithmetic, before it becomes an `f64` (counts above 2^53 would lose ticks).
-    base: (i64, i64),
+    /// Every record's counts (left, right) relative to the first record's, taken in
+    /// integer arithmetic before they become `f64` (counts above 2^53 would lose
+    /// ticks).
+    counts: Vec<(f64, f64)>,
+    /// The count rates (ticks/s) at every record, from [`slope_at`].
+    slopes: Vec<(f64, f64)>,
 }
 
 impl<'a> EncoderTrack<'a> {
     /// A track over records sorted by time, with the wheel's ticks per revolution.
     pub fn new(records: &'a [EncoderRecord], ticks_per_revolution: f64) -> Self {
+        let base = records.first().map_or((0, 0), |r| (r.left, r.right));
         EncoderTrack {
             records,
             rad_per_tick: std::f64::consts::TAU / ticks_per_revolution,
-            base: records.first().map_or((0, 0), |r| (r.left, r.right)),
+            counts: records
+                .iter()
+                .map(|r| (relative(r.left, base.0), relative(r.right, base.1)))
+                .collect(),
+            slopes: (0..records.len()).map(|k| slope_at(records, k)).collect(),
         }
     }
 
-    /// A count relative to the first record's, exact while the difference is below
-    /// 2^53 ticks (however large the counts themselves are).
-    fn relative(count: i64, base: i64) -> f64 {
-        (i128::from(count) - i128::from(base)) as f64
+    /// Record `i`'s counts (left, right) relative to the first record's.
+    #[inline]
+    fn counts(&self, i: usize) -> (f64, f64) {
+        self.counts[i]
     }
 
-    /// Record `i`'s counts (left, right) relative to the first record's.
-    fn counts(&self, i: usize) -> (f64, f64) {
-        let r = &self.records[i];
-        (
-            Self::relative(r.left, self.base.0),
-            Self::relative(r.right, self.base.1),
-        )
+    /// The count rates (ticks/s, left and right) at record `k`.
+    #[inline]
+    fn slope(&self, k: usize) -> (f64, f64) {
+        self.slopes[k]
     }
 
     /// Radians of wheel rotation per tick.
@@ -243,11 +283,24 @@ impl<'a> EncoderTrack<'a> {
     /// Index `i` of the records bracketing `t`: `records[i-1].t ≤ t < records[i].t`
     /// (or `t` equal to the last record's time, bracketed by the last two).
     fn bracket(&self, t: f64, max_gap: f64) -> Result<usize, DiscardReason> {
+        self.bracket_near(t, max_gap, 0)
+    }
+
+    /// [`EncoderTrack::bracket`], trying first the index `hint` and its neighbours
+    /// (the answer for a nearby instant) before a binary search; the same answer.
+    fn bracket_near(&self, t: f64, max_gap: f64, hint: usize) -> Result<usize, DiscardReason> {
         let n = self.records.len();
         if n < 2 || !t.is_finite() {
             return Err(DiscardReason::EncoderGap);
         }
-        let mut i = self.records.partition_point(|r| r.t <= t);
+        // Records sorted by time: `records[j-1].t ≤ t < records[j].t` makes `j` the
+        // partition point.
+        let brackets =
+            |j: usize| j >= 1 && j < n && self.records[j - 1].t <= t && t < self.records[j].t;
+        let mut i = [hint, hint.wrapping_sub(1), hint + 1]
+            .into_iter()
+            .find(|&j| brackets(j))
+            .unwrap_or_else(|| self.records.partition_point(|r| r.t <= t));
         if i == n && self.records[n - 1].t == t {
             i = n - 1;
         }
@@ -262,7 +315,7 @@ impl<'a> EncoderTrack<'a> {
 
     /// Cumulative ticks (left, right) at `t` between records `i-1` and `i`: the cubic
     /// Hermite curve through the two records with the slopes of
-    /// [`EncoderTrack::slope`]. Exact on counts that grow with constant acceleration
+    /// [`slope_at`]. Exact on counts that grow with constant acceleration
     /// (linear interpolation is not: with encoder records 0.1 s apart, as when the counts
     /// are stored with each scan, its error at the ends of the intervals biased the wheel
     /// radii by about 1σ per 75 s of a 0.6 m/s robot).
@@ -284,32 +337,6 @@ impl<'a> EncoderTrack<'a> {
             h00 * pa + h10 * span * ma + h01 * pb + h11 * span * mb
         };
         (curve(pa.0, pb.0, sa.0, sb.0), curve(pa.1, pb.1, sa.1, sb.1))
-    }
-
-    /// The count rates (ticks/s, left and right) at record `k`: the three-point
-    /// derivative from the two neighbouring records (the secant of the one segment at
-    /// the ends of the stream or next to colliding timestamps).
-    fn slope(&self, k: usize) -> (f64, f64) {
-        let secant = |j: usize| -> Option<(f64, f64, f64)> {
-            let (p, q) = (self.records.get(j)?, self.records.get(j + 1)?);
-            let h = q.t - p.t;
-            (h > 0.0).then(|| {
-                (
-                    h,
-                    Self::relative(q.left, p.left) / h,
-                    Self::relative(q.right, p.right) / h,
-                )
-            })
-        };
-        let before = k.checked_sub(1).and_then(secant);
-        match (before, secant(k)) {
-            (Some((h0, l0, r0)), Some((h1, l1, r1))) => (
-                (h1 * l0 + h0 * l1) / (h0 + h1),
-                (h1 * r0 + h0 * r1) / (h0 + h1),
-            ),
-            (Some((_, l, r)), None) | (None, Some((_, l, r))) => (l, r),
-            (None, None) => (0.0, 0.0),
-        }
     }
 
     /// Appends the motion from `from` to `to` (time, left and right ticks), both
@@ -343,6 +370,20 @@ impl<'a> EncoderTrack<'a> {
     /// or why they are not known well enough.
     pub fn ticks_at(&self, t: f64, max_gap: f64) -> Result<(f64, f64), DiscardReason> {
         let i = self.bracket(t, max_gap)?;
+        Ok(self.ticks_between(i, t))
+    }
+
+    /// [`EncoderTrack::ticks_at`] for a run of nearby instants: `hint` holds the
+    /// record index found for the previous one (start with 0) and is updated. The
+    /// same values, without a binary search per instant.
+    pub fn ticks_at_near(
+        &self,
+        t: f64,
+        max_gap: f64,
+        hint: &mut usize,
+    ) -> Result<(f64, f64), DiscardReason> {
+        let i = self.bracket_near(t, max_gap, *hint)?;
+        *hint = i;
         Ok(self.ticks_between(i, t))
     }
 
@@ -452,6 +493,34 @@ mod tests {
         assert_eq!(idx, vec![(0, 3), (3, 6), (6, 9)]);
         assert_eq!(scan_pairs(&t, 1).len(), 9);
         assert!(scan_pairs(&t[..1], 1).is_empty());
+    }
+
+    #[test]
+    fn ticks_near_a_hint_are_the_ticks_at_the_instant() {
+        // Irregular records with a repeated timestamp; instants walked both ways in
+        // steps shorter and longer than the records' spacing, from stale hints too,
+        // and beyond both ends.
+        let mut recs: Vec<EncoderRecord> = (0..60)
+            .map(|k| rec(k as f64 * 0.02 + 0.003 * (k % 3) as f64, 7 * k * k, -5 * k))
+            .collect();
+        recs[30].t = recs[29].t;
+        let track = EncoderTrack::new(&recs, 100.0);
+        for step in [0.004, 0.01, 0.03, -0.01, -0.05] {
+            for start_hint in [0, 17, 59, 200] {
+                let mut hint = start_hint;
+                for k in 0..400 {
+                    let t = if step > 0.0 { -0.1 } else { 1.3 } + step * k as f64;
+                    for gap in [0.05, f64::INFINITY] {
+                        let mut h = hint;
+                        let near = track.ticks_at_near(t, gap, &mut h);
+                        assert_eq!(near, track.ticks_at(t, gap), "t {t}, gap {gap}");
+                        if gap.is_infinite() {
+                            hint = h;
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -46,6 +46,7 @@ mod calibrate;
 mod constraints;
 mod covariance;
 mod error;
+mod inflate;
 mod kinematics;
 mod linalg;
 mod noise;
@@ -70,6 +71,7 @@ pub use constraints::{
 };
 pub use covariance::INFORMATION_SINGULAR_RATIO;
 pub use error::SolveError;
+pub use inflate::inflate_sigma;
 pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
 pub use observability::{

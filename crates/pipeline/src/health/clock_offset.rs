@@ -9,6 +9,7 @@ use crate::options::Options;
 use crate::sync::EncoderTrack;
 use crate::synchronized::Synchronized;
 use odocal_log::Log;
+use rayon::prelude::*;
 
 /// Half-width (s) of the quick check's search around the offset in use.
 pub const QUICK_RANGE_S: f64 = 2.0;
@@ -79,11 +80,34 @@ pub fn quick_estimate(
             .collect()
     };
     let n = (range / QUICK_STEP_S).round() as i64;
-    let grid: Vec<(f64, f64)> = (-n..=n)
-        .filter_map(|i| {
-            let d = center + i as f64 * QUICK_STEP_S;
-            let c = correlation(&theta, &rotation_at(d)?);
-            c.is_finite().then_some((d, c))
+    let deltas: Vec<f64> = (-n..=n).map(|i| center + i as f64 * QUICK_STEP_S).collect();
+    // Per sample (in parallel), its wheel rotation at every grid offset: the instants
+    // move one step at a time, so each is found next to the last one's records.
+    let per_sample: Vec<Vec<Option<f64>>> = used
+        .par_iter()
+        .map(|s| {
+            let (mut h0, mut h1) = (0, 0);
+            deltas
+                .iter()
+                .map(|&d| {
+                    let (l0, r0) = track
+                        .ticks_at_near(s.pair.t0 - d, f64::INFINITY, &mut h0)
+                        .ok()?;
+                    let (l1, r1) = track
+                        .ticks_at_near(s.pair.t1 - d, f64::INFINITY, &mut h1)
+                        .ok()?;
+                    Some((r1 - r0) - (l1 - l0))
+                })
+                .collect()
+        })
+        .collect();
+    // A grid point counts when every sample has its rotation there.
+    let grid: Vec<(f64, f64)> = (0..deltas.len())
+        .into_par_iter()
+        .filter_map(|k| {
+            let rotation: Vec<f64> = per_sample.iter().map(|r| r[k]).collect::<Option<_>>()?;
+            let c = correlation(&theta, &rotation);
+            c.is_finite().then_some((deltas[k], c))
         })
         .collect();
     let (k, &(best, corr)) = grid

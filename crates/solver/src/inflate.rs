@@ -1,0 +1,30 @@
+//! Scaling a calibration's covariance when its noise model is found too small by a
+//! measurement outside the solver (the scan matcher's own error, say): the σ, the
+//! verdicts and the sentence follow.
+
+use crate::calibrate::Calibration;
+use crate::constraints::Constraints;
+use crate::observability::{parameter_reports, sentence};
+
+/// Multiplies every σ of `calibration` by `factor` (the covariance by `factor²`) and
+/// judges the parameters again; a `factor` that is not finite or below 1 changes
+/// nothing (the covariance is only ever made more conservative here).
+pub fn inflate_sigma(calibration: &mut Calibration, factor: f64) {
+    if !(factor.is_finite() && factor > 1.0) {
+        return;
+    }
+    let f2 = factor * factor;
+    for row in calibration.covariance.iter_mut() {
+        for v in row.iter_mut() {
+            *v *= f2;
+        }
+    }
+    let obs = &mut calibration.observability;
+    let constraints = Constraints(std::array::from_fn(|i| {
+        obs.parameters
+            .get(i)
+            .map_or(Default::default(), |p| p.constraint)
+    }));
+    obs.parameters = parameter_reports(&calibration.params, &calibration.covariance, &constraints);
+    obs.sentence = sentence(&obs.parameters, &obs.motion);
+}
