@@ -9,6 +9,7 @@
 use crate::consistency::Consistency;
 use crate::error::PipelineError;
 use crate::finding::Finding;
+use crate::lasers::{solve, Solved};
 use crate::log_agreement::{check_log, information_shares};
 use crate::options::{Options, MIN_SAMPLES};
 use crate::progress::Progress;
@@ -18,7 +19,7 @@ use crate::self_check::MatchSelfCheck;
 use crate::sync::DiscardCounts;
 use crate::synchronized::Synchronized;
 use odocal_log::Log;
-use odocal_solver::Sample;
+use odocal_solver::{LasersCalibration, Sample};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -53,6 +54,11 @@ pub struct JointOutcome {
     pub joint: Outcome,
     /// Per log, in the same order: what it contributed and whether it agrees.
     pub contributions: Vec<Contribution>,
+    /// Per log, in the same order: its laser (0: the first log's).
+    pub laser_of_log: Vec<usize>,
+    /// With more than one laser: the joint estimate with every laser's ℓ (the
+    /// `joint` outcome's calibration is the first laser's view of it).
+    pub lasers: Option<LasersCalibration>,
 }
 
 /// Why [`calibrate_logs`] failed.
@@ -87,9 +93,23 @@ pub enum JointError {
 
 /// Calibrates one robot from several logs: `logs` pairs each log with the name the
 /// messages give it (its path). Scan matching runs on rayon's current thread pool,
-/// one log after another (each log's pairs in parallel).
+/// one log after another (each log's pairs in parallel). One laser: every log's.
 pub fn calibrate_logs(
     logs: &[(&str, &Log)],
+    opts: &Options,
+    progress: &dyn Progress,
+) -> Result<JointOutcome, JointError> {
+    calibrate_logs_with_lasers(logs, &vec![0; logs.len()], opts, progress)
+}
+
+/// [`calibrate_logs`] with each log's laser: `laser_of_log[i]` is log `i`'s laser
+/// (0 for the first log's, then 1, 2, … in order; [`crate::laser_indices`] numbers
+/// them from keys). The wheels are shared; each laser gets its own ℓ. Every laser
+/// needs its log(s) to determine its ℓ; held parameters and priors are refused with
+/// more than one laser.
+pub fn calibrate_logs_with_lasers(
+    logs: &[(&str, &Log)],
+    laser_of_log: &[usize],
     opts: &Options,
     progress: &dyn Progress,
 ) -> Result<JointOutcome, JointError> {
@@ -128,13 +148,27 @@ pub fn calibrate_logs(
         }));
     }
     let solve_options = opts.solve_options();
-    let calibration = odocal_solver::calibrate(&samples, &solve_options)
+    // Numbered densely from the first log's laser, whatever numbers were given.
+    let laser_of_log = crate::lasers::laser_indices(laser_of_log);
+    let laser_of: Vec<usize> = outcomes
+        .iter()
+        .zip(&laser_of_log)
+        .flat_map(|(o, &k)| std::iter::repeat_n(k, o.synced.samples.len()))
+        .collect();
+    let solved = solve(&samples, &laser_of, &solve_options)
         .map_err(|e| JointError::Joint(PipelineError::from(e).with_faults(&health)))?;
     let agreements: Vec<Consistency> = logs
         .iter()
         .zip(&outcomes)
-        .map(|((name, _), o)| check_log(&o.calibration, &calibration, &solve_options, name))
+        .zip(&laser_of_log)
+        .map(|(((name, _), o), &k)| {
+            check_log(&o.calibration, &solved.view(k), &solve_options, name)
+        })
         .collect();
+    let Solved {
+        first: calibration,
+        lasers,
+    } = solved;
     let calibration =
         match refuse_poorly_determined(calibration, &synced, &samples, &solve_options, opts) {
             Ok(c) => c,
@@ -206,6 +240,8 @@ pub fn calibrate_logs(
         logs: outcomes,
         joint,
         contributions,
+        laser_of_log,
+        lasers,
     })
 }
 

@@ -10,6 +10,7 @@
 //! Lasers never share a scan, so their scores are independent.
 
 use crate::calibrate::{calibrate, Calibration, NoiseSource, SolveOptions};
+use crate::constraints::Constraints;
 use crate::error::SolveError;
 use crate::kinematics::{residual_of, Predictor};
 use crate::linalg::information_from_covariance;
@@ -330,23 +331,37 @@ pub fn calibrate_lasers(
         cost_after,
         iterations,
     };
-    out.first = first_view(&out, options);
+    out.first = out.view(0);
     Ok(out)
 }
 
-/// The first laser's [`Calibration`] with the joint wheels, ℓ₁ and covariance block.
-fn first_view(joint: &LasersCalibration, options: &SolveOptions) -> Calibration {
-    let params = joint.params_of(0);
-    let covariance = joint.covariance_of(0);
-    let mut c = joint.own[0].clone();
-    let reports = parameter_reports(&params, &covariance, &options.constraints);
-    c.observability.sentence = sentence(&reports, &c.observability.motion);
-    c.observability.parameters = reports;
-    c.observability.wheel_signs = wheel_signs(&params);
-    c.j = params.j();
-    c.params = params;
-    c.covariance = covariance;
-    c
+impl LasersCalibration {
+    /// Laser `k`'s view of the joint estimate as a single-laser [`Calibration`]: the
+    /// shared wheels, ℓ_k, the 6×6 block of the joint covariance and the verdicts
+    /// from it, the joint costs and the samples the joint estimate used (all lasers');
+    /// trimming rounds, noise and motion content from laser `k`'s own solve.
+    pub fn view(&self, k: usize) -> Calibration {
+        let params = self.params_of(k);
+        let covariance = self.covariance_of(k);
+        let mut c = self.own[k].clone();
+        // No parameter is held or has a prior here (refused by `calibrate_lasers`).
+        let reports = parameter_reports(&params, &covariance, &Constraints::default());
+        c.observability.sentence = sentence(&reports, &c.observability.motion);
+        c.observability.parameters = reports;
+        c.observability.wheel_signs = wheel_signs(&params);
+        c.j = params.j();
+        c.params = params;
+        c.covariance = covariance;
+        c.used = self.used.clone();
+        c.samples_used = self.used.iter().filter(|u| **u).count();
+        c.cost_before = self.cost_before;
+        c.cost_after = self.cost_after;
+        let dof = (3 * c.samples_used)
+            .saturating_sub(self.params.len())
+            .max(1);
+        c.reduced_chi2 = self.cost_after / dof as f64;
+        c
+    }
 }
 
 /// Levenberg–Marquardt over all `3 + 3K` parameters from `start`: the estimate, the
