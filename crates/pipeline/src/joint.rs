@@ -9,7 +9,7 @@
 use crate::consistency::Consistency;
 use crate::error::PipelineError;
 use crate::finding::Finding;
-use crate::lasers::{solve, Solved};
+use crate::lasers::{comparison_options, solve, Solved};
 use crate::log_agreement::{check_log, information_shares};
 use crate::options::{Options, MIN_SAMPLES};
 use crate::progress::Progress;
@@ -80,12 +80,15 @@ pub enum JointError {
     /// The joint estimate was refused, and logs disagree with it: they do not
     /// describe one robot with one mounting.
     #[error(
-        "the logs do not describe one robot: {sentences}; calibrate them separately, or \
-         without the log(s) named (the joint estimate was refused: {refusal})"
+        "the logs do not describe one robot: {sentences}; {own_laser}calibrate them \
+         separately, or without the log(s) named (the joint estimate was refused: {refusal})"
     )]
     Disagree {
         /// Each disagreeing log's sentence, joined.
         sentences: String,
+        /// "if the laser was mounted elsewhere for some of them, give each its own ℓ:
+        /// `odocal calibrate … --own-laser N`; " (empty when no such command applies).
+        own_laser: String,
         /// The joint refusal.
         refusal: PipelineError,
     },
@@ -102,11 +105,12 @@ pub fn calibrate_logs(
     calibrate_logs_with_lasers(logs, &vec![0; logs.len()], opts, progress)
 }
 
-/// [`calibrate_logs`] with each log's laser: `laser_of_log[i]` is log `i`'s laser
-/// (0 for the first log's, then 1, 2, … in order; [`crate::laser_indices`] numbers
-/// them from keys). The wheels are shared; each laser gets its own ℓ. Every laser
-/// needs its log(s) to determine its ℓ; held parameters and priors are refused with
-/// more than one laser.
+/// [`calibrate_logs`] with each log's laser: logs with equal `laser_of_log` numbers
+/// share a laser (renumbered from 0, the first log's, in order of appearance;
+/// [`crate::laser_indices`] numbers them from keys). The wheels are shared; each
+/// laser gets its own ℓ. The laser pose of `opts.initial_params` (scan matching's
+/// first guesses) is taken as the first laser's: the logs of other lasers bootstrap
+/// their guesses. Held parameters and priors are refused with more than one laser.
 pub fn calibrate_logs_with_lasers(
     logs: &[(&str, &Log)],
     laser_of_log: &[usize],
@@ -117,9 +121,21 @@ pub fn calibrate_logs_with_lasers(
         accept_weak: true,
         ..opts.clone()
     };
+    // The nominal laser pose (first guesses of scan matching) is the first laser's:
+    // the logs of other lasers find their guesses by the bootstrap instead.
+    let other_laser = Options {
+        initial_params: None,
+        ..lenient.clone()
+    };
+    // Numbered densely from the first log's laser, whatever numbers were given.
+    let laser_of_log = crate::lasers::laser_indices(laser_of_log);
     let mut outcomes = Vec::with_capacity(logs.len());
     for (index, (name, log)) in logs.iter().enumerate() {
-        let outcome = calibrate_log(log, &lenient, progress).map_err(|source| JointError::Log {
+        let own = match laser_of_log.get(index) {
+            Some(&k) if k > 0 => &other_laser,
+            _ => &lenient,
+        };
+        let outcome = calibrate_log(log, own, progress).map_err(|source| JointError::Log {
             index,
             name: name.to_string(),
             source,
@@ -148,8 +164,6 @@ pub fn calibrate_logs_with_lasers(
         }));
     }
     let solve_options = opts.solve_options();
-    // Numbered densely from the first log's laser, whatever numbers were given.
-    let laser_of_log = crate::lasers::laser_indices(laser_of_log);
     let laser_of: Vec<usize> = outcomes
         .iter()
         .zip(&laser_of_log)
@@ -162,7 +176,11 @@ pub fn calibrate_logs_with_lasers(
         .zip(&outcomes)
         .zip(&laser_of_log)
         .map(|(((name, _), o), &k)| {
-            check_log(&o.calibration, &solved.view(k), &solve_options, name)
+            let view = solved.view(k);
+            let alone =
+                solved.lasers.is_some() && laser_of_log.iter().filter(|&&j| j == k).count() == 1;
+            let compared = comparison_options(&solve_options, &view, alone);
+            check_log(&o.calibration, &view, &compared, name, alone)
         })
         .collect();
     let Solved {
@@ -176,18 +194,26 @@ pub fn calibrate_logs_with_lasers(
                 // Logs of different robots (or mountings) make one model fit none of them:
                 // the residuals grow and the joint verdicts weaken. Name the logs that
                 // disagree rather than ask for more driving.
-                let disagreeing: Vec<String> = agreements
+                let disagreeing: Vec<(usize, String)> = agreements
                     .iter()
-                    .filter_map(|a| match a {
-                        Consistency::Checked(h) if !h.agree => Some(h.sentence.clone()),
+                    .enumerate()
+                    .filter_map(|(i, a)| match a {
+                        Consistency::Checked(h) if !h.agree => Some((i, h.sentence.clone())),
                         _ => None,
                     })
                     .collect();
                 return Err(if disagreeing.is_empty() {
                     JointError::Joint(refusal.with_faults(&health))
                 } else {
+                    let names: Vec<&str> = logs.iter().map(|(n, _)| *n).collect();
+                    let which: Vec<usize> = disagreeing.iter().map(|(i, _)| *i).collect();
                     JointError::Disagree {
-                        sentences: disagreeing.join("; "),
+                        sentences: disagreeing
+                            .into_iter()
+                            .map(|(_, s)| s)
+                            .collect::<Vec<_>>()
+                            .join("; "),
+                        own_laser: own_laser_hint(&names, &which, &laser_of_log),
                         refusal,
                     }
                 });
@@ -243,6 +269,29 @@ pub fn calibrate_logs_with_lasers(
         laser_of_log,
         lasers,
     })
+}
+
+/// The command that gives the disagreeing logs (`which`, positions in `names`) their
+/// own laser: every disagreeing log but the first log (whose laser is the reference),
+/// or the first when it alone disagrees; empty when the logs already have lasers of
+/// their own (several lasers: the disagreement is not the mounting).
+fn own_laser_hint(names: &[&str], which: &[usize], laser_of_log: &[usize]) -> String {
+    if laser_of_log.iter().any(|&k| k > 0) {
+        return String::new();
+    }
+    let mut own: Vec<usize> = which.iter().copied().filter(|&i| i > 0).collect();
+    if own.is_empty() {
+        own.push(0);
+    }
+    let flags: String = own
+        .iter()
+        .map(|i| format!(" --own-laser {}", i + 1))
+        .collect();
+    format!(
+        "if the laser was mounted elsewhere for some of them, give each its own ℓ with the \
+         wheels shared (`odocal calibrate {}{flags}`, with the other options you gave); ",
+        names.join(" ")
+    )
 }
 
 /// Every log's solver samples, in log order, each log with its own read-time noise,

@@ -3,7 +3,8 @@
 //! solve with the wheels shared and one ℓ per laser, and each laser's view of it.
 
 use odocal_solver::{
-    calibrate, calibrate_lasers, Calibration, LasersCalibration, SolveError, SolveOptions,
+    calibrate, calibrate_lasers, Calibration, Constraint, LasersCalibration, SolveError,
+    SolveOptions,
 };
 
 /// The joint estimate: the first laser's view (what every single-laser stage reads)
@@ -43,6 +44,24 @@ impl Solved {
             _ => self.first.clone(),
         }
     }
+}
+
+/// The options a log is compared with the joint estimate under: with several lasers,
+/// a log that is the only one of its laser brought all of that laser's information
+/// on ℓ, so only the shared wheels are compared (ℓ counts as held at `view`'s).
+pub(crate) fn comparison_options(
+    options: &SolveOptions,
+    view: &Calibration,
+    alone_on_its_laser: bool,
+) -> SolveOptions {
+    let mut o = *options;
+    if alone_on_its_laser {
+        let v = view.params.to_vector();
+        for i in 3..6 {
+            o.constraints.0[i] = Constraint::Held(v[i]);
+        }
+    }
+    o
 }
 
 /// Laser indices (0 = the first log's laser) from each log's laser key: logs with
