@@ -80,15 +80,13 @@ pub enum JointError {
     /// The joint estimate was refused, and logs disagree with it: they do not
     /// describe one robot with one mounting.
     #[error(
-        "the logs do not describe one robot: {sentences}; {own_laser}calibrate them \
-         separately, or without the log(s) named (the joint estimate was refused: {refusal})"
+        "the logs do not describe one robot: {sentences}; calibrate them separately, or \
+         without the log(s) named (the joint estimate was refused: {refusal})"
     )]
     Disagree {
-        /// Each disagreeing log's sentence, joined.
+        /// Each disagreeing log's sentence, joined, and (when it applies) the command
+        /// that gives the logs whose laser was mounted elsewhere their own ℓ.
         sentences: String,
-        /// "if the laser was mounted elsewhere for some of them, give each its own ℓ:
-        /// `odocal calibrate … --own-laser N`; " (empty when no such command applies).
-        own_laser: String,
         /// The joint refusal.
         refusal: PipelineError,
     },
@@ -207,13 +205,11 @@ pub fn calibrate_logs_with_lasers(
                 } else {
                     let names: Vec<&str> = logs.iter().map(|(n, _)| *n).collect();
                     let which: Vec<usize> = disagreeing.iter().map(|(i, _)| *i).collect();
+                    let mut sentences: Vec<String> =
+                        disagreeing.into_iter().map(|(_, s)| s).collect();
+                    sentences.extend(own_laser_hint(&names, &which, &laser_of_log));
                     JointError::Disagree {
-                        sentences: disagreeing
-                            .into_iter()
-                            .map(|(_, s)| s)
-                            .collect::<Vec<_>>()
-                            .join("; "),
-                        own_laser: own_laser_hint(&names, &which, &laser_of_log),
+                        sentences: sentences.join("; "),
                         refusal,
                     }
                 });
@@ -273,11 +269,11 @@ pub fn calibrate_logs_with_lasers(
 
 /// The command that gives the disagreeing logs (`which`, positions in `names`) their
 /// own laser: every disagreeing log but the first log (whose laser is the reference),
-/// or the first when it alone disagrees; empty when the logs already have lasers of
+/// or the first when it alone disagrees; `None` when the logs already have lasers of
 /// their own (several lasers: the disagreement is not the mounting).
-fn own_laser_hint(names: &[&str], which: &[usize], laser_of_log: &[usize]) -> String {
+fn own_laser_hint(names: &[&str], which: &[usize], laser_of_log: &[usize]) -> Option<String> {
     if laser_of_log.iter().any(|&k| k > 0) {
-        return String::new();
+        return None;
     }
     let mut own: Vec<usize> = which.iter().copied().filter(|&i| i > 0).collect();
     if own.is_empty() {
@@ -287,11 +283,11 @@ fn own_laser_hint(names: &[&str], which: &[usize], laser_of_log: &[usize]) -> St
         .iter()
         .map(|i| format!(" --own-laser {}", i + 1))
         .collect();
-    format!(
+    Some(format!(
         "if the laser was mounted elsewhere for some of them, give each its own ℓ with the \
-         wheels shared (`odocal calibrate {}{flags}`, with the other options you gave); ",
+         wheels shared (`odocal calibrate {}{flags}`, with the other options you gave)",
         names.join(" ")
-    )
+    ))
 }
 
 /// Every log's solver samples, in log order, each log with its own read-time noise,

@@ -57,8 +57,8 @@ pub(crate) fn comparison_options(
     let mut o = *options;
     if alone_on_its_laser {
         let v = view.params.to_vector();
-        for i in 3..6 {
-            o.constraints.0[i] = Constraint::Held(v[i]);
+        for (c, &value) in o.constraints.0.iter_mut().zip(&v).skip(3) {
+            *c = Constraint::Held(value);
         }
     }
     o
