@@ -311,7 +311,16 @@ pub fn calibrate_lasers(
                    calibrate each laser on its own to see which motion is missing"
             .into(),
     })?;
-    let covariance = sandwich(&groups, &params, &inverse);
+    let (covariance, shared) = sandwich(&groups, &params, &inverse);
+    // With scans shared by consecutive samples the lasers' true covariances are the
+    // sandwiches, not H⁻¹, and an H-weighted fit mixes the lasers' wheels with the
+    // wrong weights (the two-lidar fixture: σ_b 1.01 mm jointly, 0.71 mm from the
+    // rear lidar alone). Then the estimate is the lasers' own estimates combined by
+    // generalized least squares with those covariances (first-order ML for them).
+    let (params, covariance) = match shared.then(|| combine(&own)).flatten() {
+        Some(combined) => combined,
+        None => (params, covariance),
+    };
 
     let mut used = vec![false; samples.len()];
     for (group, idx) in groups.iter().zip(&members) {
@@ -442,7 +451,7 @@ fn invert(h: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 
 /// `H⁻¹ M H⁻¹` with `M` the score's covariance: per laser, its shared-scan score
 /// (when its samples carry scan times) or its block of `H` (independent samples).
-fn sandwich(groups: &[Group], params: &[f64], inverse: &DMatrix<f64>) -> DMatrix<f64> {
+fn sandwich(groups: &[Group], params: &[f64], inverse: &DMatrix<f64>) -> (DMatrix<f64>, bool) {
     let n = params.len();
     let mut meat = DMatrix::zeros(n, n);
     let mut any_shared = false;
@@ -468,8 +477,41 @@ fn sandwich(groups: &[Group], params: &[f64], inverse: &DMatrix<f64>) -> DMatrix
         }
     }
     if !any_shared {
-        return inverse.clone();
+        return (inverse.clone(), false);
     }
     let c = inverse * meat * inverse;
-    DMatrix::from_fn(n, n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]))
+    (
+        DMatrix::from_fn(n, n, |i, j| 0.5 * (c[(i, j)] + c[(j, i)])),
+        true,
+    )
+}
+
+/// The lasers' own estimates (wheels and ℓ_k, covariance C_k) combined by generalized
+/// least squares: `x = (Σ P_kᵀ C_k⁻¹ P_k)⁻¹ Σ P_kᵀ C_k⁻¹ θ_k` with `P_k` selecting the
+/// wheels and ℓ_k, and its covariance `(Σ P_kᵀ C_k⁻¹ P_k)⁻¹`; `None` when a
+/// covariance cannot be inverted.
+fn combine(own: &[Calibration]) -> Option<(Vec<f64>, DMatrix<f64>)> {
+    let n = 3 + 3 * own.len();
+    let mut a = DMatrix::zeros(n, n);
+    let mut b = DVector::zeros(n);
+    for (k, c) in own.iter().enumerate() {
+        let ix = LasersCalibration::indices(k);
+        let ck = DMatrix::from_fn(6, 6, |i, j| c.covariance[i][j]);
+        let info = invert(&ck)?;
+        let theta = DVector::from_column_slice(&c.params.to_vector());
+        let weighted = &info * theta;
+        for i in 0..6 {
+            b[ix[i]] += weighted[i];
+            for j in 0..6 {
+                a[(ix[i], ix[j])] += info[(i, j)];
+            }
+        }
+    }
+    let covariance = invert(&a)?;
+    let x = &covariance * b;
+    let mut params: Vec<f64> = x.iter().copied().collect();
+    for k in 0..own.len() {
+        params[5 + 3 * k] = wrap_angle(params[5 + 3 * k]);
+    }
+    Some((params, covariance))
 }
