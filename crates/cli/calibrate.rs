@@ -10,7 +10,7 @@ use crate::progress_bar::Bar;
 use crate::terminal::{out, outln, write_json_stdout};
 use anyhow::Context;
 use odocal_log::Log;
-use odocal_pipeline::{calibrate_log, calibrate_logs, Options, Trim};
+use odocal_pipeline::{calibrate_log, calibrate_logs_with_lasers, laser_indices, Options, Trim};
 use odocal_report::{
     build_joint_report, build_report, sha256_of_input, write_html, write_outputs, NominalLaserPose,
     Provenance,
@@ -90,6 +90,12 @@ pub struct Args {
     pub second_pass: bool,
     #[command(flatten)]
     pub partial: PartialArgs,
+    /// Give log N (its position among the LOGs, from 1) a laser of its own: its own ℓ,
+    /// the wheels shared with the other logs (a laser re-mounted between recordings, or
+    /// another laser of the robot logged separately). Repeatable; logs not named share
+    /// the first log's laser.
+    #[arg(long, value_name = "N")]
+    pub own_laser: Vec<usize>,
     /// Write results.json, samples.tuple, results.html (and figures with --plots) into DIR.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
@@ -102,6 +108,24 @@ pub struct Args {
     /// Print one JSON object instead of the human summary.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `--own-laser` positions: each names one of the `logs` LOGs (from 1), and there are
+/// at least two logs (one log has one laser).
+fn check_own_laser(own: &[usize], logs: usize) -> anyhow::Result<()> {
+    if let Some(&n) = own.iter().find(|&&n| n == 0 || n > logs) {
+        anyhow::bail!(
+            "--own-laser {n}: N is a log's position among the {logs} LOG(s) given, from 1 \
+             (e.g. `odocal calibrate A.log B.log --own-laser 2` gives B.log its own laser)"
+        );
+    }
+    if !own.is_empty() && logs < 2 {
+        anyhow::bail!(
+            "--own-laser gives one of several logs a laser of its own; with one log there \
+             is one laser (a bag with two lasers: repeat --scan-topic)"
+        );
+    }
+    Ok(())
 }
 
 /// A positive, finite number of seconds (for `--time-offset-range`).
@@ -130,19 +154,45 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     let t_parse = Instant::now();
-    let paths = input.paths();
-    let inputs = input.read_logs()?;
+    let files = input.paths();
+    check_own_laser(&args.own_laser, files.len())?;
+    let inputs = input.read_lasers()?;
     let parse_s = t_parse.elapsed().as_secs_f64();
+    // One entry per laser's log: a bag read for several scan topics is one per topic.
+    let several_topics = input.read.scan_topic.len() > 1;
+    let log_index: Vec<usize> = inputs.iter().map(|(i, _)| *i).collect();
+    let paths: Vec<&std::path::Path> = log_index.iter().map(|&i| files[i]).collect();
+    let topics: Vec<Option<String>> = inputs.iter().map(|(_, r)| r.scan_topic.clone()).collect();
+    let names: Vec<String> = paths
+        .iter()
+        .zip(&topics)
+        .map(|(p, t)| match t {
+            Some(t) if several_topics => format!("{} {t}", p.display()),
+            _ => p.display().to_string(),
+        })
+        .collect();
+    // A log's laser: its own with --own-laser, else its topic's with several topics.
+    let laser_keys: Vec<(Option<usize>, Option<&str>)> = log_index
+        .iter()
+        .zip(&topics)
+        .map(|(&i, t)| {
+            (
+                args.own_laser.contains(&(i + 1)).then_some(i),
+                t.as_deref().filter(|_| several_topics),
+            )
+        })
+        .collect();
+    let laser_of_log = laser_indices(&laser_keys);
     // The laser's nominal pose from the first bag with static transforms.
-    let laser = inputs.iter().find_map(|r| r.nominal_laser.clone());
+    let laser = inputs.iter().find_map(|(_, r)| r.nominal_laser.clone());
     // The bag's wheel joint states and IMU topics, for a gyro-heading refusal.
-    let heading_sources = inputs.iter().find_map(|r| r.heading_sources.clone());
+    let heading_sources = inputs.iter().find_map(|(_, r)| r.heading_sources.clone());
     let refused = |e| match with_joint_states_command(e, heading_sources.as_ref()) {
         Ok(heading) => anyhow::Error::from(heading),
         Err(e) => crate::partial_args::with_hold_command(e),
     };
     let (mut logs, mut checksums): (Vec<Log>, Vec<Option<(String, u64)>>) =
-        inputs.into_iter().map(|r| (r.log, r.checksum)).unzip();
+        inputs.into_iter().map(|(_, r)| (r.log, r.checksum)).unzip();
 
     let initial_params = input.nominal_with_laser(laser.as_ref())?;
     let mut odometry_only = None;
@@ -178,15 +228,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let report = build_report(paths[0], log, &opts, &outcome);
         (outcome, report)
     } else {
-        let named: Vec<(String, &Log)> = paths
-            .iter()
-            .map(|p| p.display().to_string())
-            .zip(&logs)
-            .collect();
-        let named: Vec<(&str, &Log)> = named.iter().map(|(p, l)| (p.as_str(), *l)).collect();
-        let joint = pool.install(|| calibrate_logs(&named, &opts, &bar))?;
+        let named: Vec<(&str, &Log)> = names.iter().map(String::as_str).zip(&logs).collect();
+        let joint =
+            pool.install(|| calibrate_logs_with_lasers(&named, &laser_of_log, &opts, &bar))?;
         let all: Vec<&Log> = logs.iter().collect();
-        let mut report = build_joint_report(&paths, &all, &opts, &joint);
+        let mut report = build_joint_report(&paths, &names, &topics, &all, &opts, &joint);
         for ((row, path), checksum) in report.logs.iter_mut().zip(&paths).zip(&mut checksums) {
             let (sha256, bytes) = match checksum.take() {
                 Some(c) => c,

@@ -1,14 +1,15 @@
 //! `odocal export results.json [--out DIR] [--format ros2-control|urdf]`: a
 //! calibration's results in ROS terms — the ros2_control `diff_drive_controller`
 //! parameters and the laser joint's URDF `<origin>` — from its `results.json`, the
-//! same files `calibrate --out DIR` writes beside it.
+//! same files `calibrate --out DIR` writes beside it. With several lasers
+//! (results.json `lasers`), the URDF file has one joint origin per laser.
 
 use crate::terminal::{out, outln};
 use anyhow::Context;
 use odocal_geom::FlatParams;
 use odocal_pipeline::write_bytes_atomically;
 use odocal_report::export::{DIFF_DRIVE_FILE, URDF_FILE};
-use odocal_report::{diff_drive_controller_yaml, laser_joint_urdf};
+use odocal_report::{diff_drive_controller_yaml, laser_joints_urdf, LaserPose};
 use std::path::PathBuf;
 
 /// Which file to export.
@@ -46,12 +47,25 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             path.display()
         )
     })?;
+    // Several lasers: results.json's `lasers`, one URDF joint origin each.
+    let lasers: Vec<LaserPose> = match serde_json::from_str::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| v.get("lasers").cloned())
+    {
+        Some(v) => serde_json::from_value(v).with_context(|| {
+            format!(
+                "{}: `lasers` is not a list of objects with l_x, l_y, l_theta (m, rad)",
+                path.display()
+            )
+        })?,
+        None => Vec::new(),
+    };
     let mut files = Vec::new();
     if args.format != Some(Format::Urdf) {
         files.push((DIFF_DRIVE_FILE, diff_drive_controller_yaml(&params)?));
     }
     if args.format != Some(Format::Ros2Control) {
-        files.push((URDF_FILE, laser_joint_urdf(&params)?));
+        files.push((URDF_FILE, laser_joints_urdf(&params, &lasers)?));
     }
     match &args.out {
         Some(dir) => {

@@ -77,6 +77,22 @@ impl InputArgs {
             .collect()
     }
 
+    /// Every log given, read once per laser ([`ReadArgs::read_input_lasers`]: a bag
+    /// with several `--scan-topic` gives one input per topic), each with the position
+    /// (from 0) of its log among [`InputArgs::paths`].
+    pub fn read_lasers(&self) -> anyhow::Result<Vec<(usize, ReadInput)>> {
+        let mut out = Vec::new();
+        for (index, path) in self.paths().into_iter().enumerate() {
+            let inputs = ReadArgs {
+                log: path.to_path_buf(),
+                ..self.read.clone()
+            }
+            .read_input_lasers()?;
+            out.extend(inputs.into_iter().map(|i| (index, i)));
+        }
+        Ok(out)
+    }
+
     /// The parameters given with `--nominal`; when they are the wheels only (three
     /// values), the laser pose is the bag's static transforms' `laser`, if any.
     /// Six values override the bag's pose.

@@ -5,7 +5,7 @@
 
 use crate::open_input::{is_bag_file, read_text_log};
 use crate::terminal::errln;
-use odocal_bag::{read_bag, BagOptions, Clock, NominalLaser, TopicChoice};
+use odocal_bag::{read_bag, read_bag_lasers, BagOptions, Clock, NominalLaser, TopicChoice};
 use odocal_log::{Log, Mode, ReadOptions};
 use std::path::PathBuf;
 
@@ -17,9 +17,11 @@ pub struct ReadArgs {
     /// a pipe or FIFO, or `-` for standard input; a bag must be a file or directory.
     #[arg(value_parser = log_path)]
     pub log: PathBuf,
-    /// Bag: the sensor_msgs/LaserScan topic (default: the only one).
+    /// Bag: the sensor_msgs/LaserScan topic (default: the only one). Repeat it for a
+    /// robot with several lasers (`calibrate` only): each topic is one laser with its
+    /// own ℓ, sweep timing and clock offset; the wheels are shared.
     #[arg(long, value_name = "TOPIC")]
-    pub scan_topic: Option<String>,
+    pub scan_topic: Vec<String>,
     /// Bag: the sensor_msgs/JointState topic with the wheel joints (default: the only one).
     #[arg(long, value_name = "TOPIC")]
     pub joint_states_topic: Option<String>,
@@ -72,7 +74,7 @@ impl ReadArgs {
     pub fn bag_options(&self) -> anyhow::Result<BagOptions> {
         Ok(BagOptions {
             choice: TopicChoice {
-                scan_topic: self.scan_topic.clone(),
+                scan_topic: self.scan_topic.first().cloned(),
                 joint_states_topic: self.joint_states_topic.clone(),
                 odom_topic: self.odom_topic.clone(),
                 wheel_joints: self.wheel_joints()?,
@@ -126,6 +128,14 @@ impl ReadArgs {
                     self.log.display()
                 );
             }
+            if self.scan_topic.len() > 1 {
+                anyhow::bail!(
+                    "{}: several --scan-topic ({}) are read by `odocal calibrate` only, one \
+                     laser each; here give one",
+                    self.log.display(),
+                    self.scan_topic.join(", ")
+                );
+            }
             let bag =
                 read_bag(&self.log, &self.bag_options()?).map_err(|e| anyhow::anyhow!("{e}"))?;
             for r in &bag.selection.reasons {
@@ -140,9 +150,10 @@ impl ReadArgs {
                 log: bag.log,
                 checksum: None,
                 nominal_laser: bag.nominal_laser,
+                scan_topic: Some(bag.selection.scan_topic),
             });
         }
-        let bag_flags = self.scan_topic.is_some()
+        let bag_flags = !self.scan_topic.is_empty()
             || self.joint_states_topic.is_some()
             || self.odom_topic.is_some()
             || self.wheel_joints.is_some()
@@ -160,7 +171,42 @@ impl ReadArgs {
             checksum: Some(checksum),
             nominal_laser: None,
             heading_sources: None,
+            scan_topic: None,
         })
+    }
+
+    /// [`ReadArgs::read_input`] once per laser: with several `--scan-topic` and a bag,
+    /// one input per topic from one read of the bag (in the order given); else the one
+    /// input.
+    pub fn read_input_lasers(&self) -> anyhow::Result<Vec<ReadInput>> {
+        if self.scan_topic.len() < 2 || !self.is_bag()? {
+            return Ok(vec![self.read_input()?]);
+        }
+        if self.ticks_per_rev.is_some() || self.encoder_modulus.is_some() {
+            return self.read_input().map(|i| vec![i]);
+        }
+        let bags = read_bag_lasers(&self.log, &self.bag_options()?, &self.scan_topic)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        if let Some(first) = bags.first() {
+            for w in &first.log.stats.warnings {
+                errln!("warning: {w}");
+            }
+        }
+        Ok(bags
+            .into_iter()
+            .map(|bag| {
+                for r in &bag.selection.reasons {
+                    errln!("{r}");
+                }
+                ReadInput {
+                    heading_sources: Some(odocal_bag::heading_sources(&bag.topics)),
+                    log: bag.log,
+                    checksum: None,
+                    nominal_laser: bag.nominal_laser,
+                    scan_topic: Some(bag.selection.scan_topic),
+                }
+            })
+            .collect())
     }
 }
 
@@ -175,6 +221,8 @@ pub struct ReadInput {
     pub nominal_laser: Option<NominalLaser>,
     /// A bag's joint-state and IMU topics (for the odometry-only heading refusal).
     pub heading_sources: Option<odocal_bag::HeadingSources>,
+    /// A bag's scan topic (`None` for a text log).
+    pub scan_topic: Option<String>,
 }
 
 /// The input path as given, except that a ROS 2 bag's `metadata.yaml` stands for its

@@ -154,6 +154,42 @@ pub fn read_bag(path: &Path, opts: &BagOptions) -> Result<BagLog, BagError> {
     })
 }
 
+/// Reads the bag at `path` once for several lasers: one [`BagLog`] per topic of
+/// `scan_topics`, in that order, each with the same wheel data and its own scans,
+/// sweep timing and nominal pose (the other choices of `opts` apply to every one;
+/// its `scan_topic` is ignored). One pass over the bag decodes every scan topic.
+pub fn read_bag_lasers(
+    path: &Path,
+    opts: &BagOptions,
+    scan_topics: &[String],
+) -> Result<Vec<BagLog>, BagError> {
+    let name = path.display().to_string();
+    let choice = TopicChoice {
+        scan_topic: None,
+        ..opts.choice.clone()
+    };
+    let (format, collected) = scan_bag(path, filter_of(&choice))?;
+    scan_topics
+        .iter()
+        .map(|topic| {
+            let choice = TopicChoice {
+                scan_topic: Some(topic.clone()),
+                ..choice.clone()
+            };
+            let selection = select::select(&name, &collected, &choice)?;
+            let log = to_log::build_log(&name, &collected, &selection, opts.clock, &opts.read)?;
+            Ok(BagLog {
+                format,
+                log,
+                nominal_laser: nominal_laser(&collected, &selection.scan_topic),
+                selection,
+                topics: collected.topics.clone(),
+                bytes_read: collected.bytes_read,
+            })
+        })
+        .collect()
+}
+
 /// The nominal pose of the laser of `scan_topic` from the static transforms.
 fn nominal_laser(c: &Collected, scan_topic: &str) -> Option<NominalLaser> {
     let frame = c

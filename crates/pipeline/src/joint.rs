@@ -9,6 +9,7 @@
 use crate::consistency::Consistency;
 use crate::error::PipelineError;
 use crate::finding::Finding;
+use crate::lasers::{comparison_options, solve, Solved};
 use crate::log_agreement::{check_log, information_shares};
 use crate::options::{Options, MIN_SAMPLES};
 use crate::progress::Progress;
@@ -18,7 +19,7 @@ use crate::self_check::MatchSelfCheck;
 use crate::sync::DiscardCounts;
 use crate::synchronized::Synchronized;
 use odocal_log::Log;
-use odocal_solver::Sample;
+use odocal_solver::{LasersCalibration, Sample};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -53,6 +54,11 @@ pub struct JointOutcome {
     pub joint: Outcome,
     /// Per log, in the same order: what it contributed and whether it agrees.
     pub contributions: Vec<Contribution>,
+    /// Per log, in the same order: its laser (0: the first log's).
+    pub laser_of_log: Vec<usize>,
+    /// With more than one laser: the joint estimate with every laser's ℓ (the
+    /// `joint` outcome's calibration is the first laser's view of it).
+    pub lasers: Option<LasersCalibration>,
 }
 
 /// Why [`calibrate_logs`] failed.
@@ -78,7 +84,8 @@ pub enum JointError {
          without the log(s) named (the joint estimate was refused: {refusal})"
     )]
     Disagree {
-        /// Each disagreeing log's sentence, joined.
+        /// Each disagreeing log's sentence, joined, and (when it applies) the command
+        /// that gives the logs whose laser was mounted elsewhere their own ℓ.
         sentences: String,
         /// The joint refusal.
         refusal: PipelineError,
@@ -87,9 +94,24 @@ pub enum JointError {
 
 /// Calibrates one robot from several logs: `logs` pairs each log with the name the
 /// messages give it (its path). Scan matching runs on rayon's current thread pool,
-/// one log after another (each log's pairs in parallel).
+/// one log after another (each log's pairs in parallel). One laser: every log's.
 pub fn calibrate_logs(
     logs: &[(&str, &Log)],
+    opts: &Options,
+    progress: &dyn Progress,
+) -> Result<JointOutcome, JointError> {
+    calibrate_logs_with_lasers(logs, &vec![0; logs.len()], opts, progress)
+}
+
+/// [`calibrate_logs`] with each log's laser: logs with equal `laser_of_log` numbers
+/// share a laser (renumbered from 0, the first log's, in order of appearance;
+/// [`crate::laser_indices`] numbers them from keys). The wheels are shared; each
+/// laser gets its own ℓ. The laser pose of `opts.initial_params` (scan matching's
+/// first guesses) is taken as the first laser's: the logs of other lasers bootstrap
+/// their guesses. Held parameters and priors are refused with more than one laser.
+pub fn calibrate_logs_with_lasers(
+    logs: &[(&str, &Log)],
+    laser_of_log: &[usize],
     opts: &Options,
     progress: &dyn Progress,
 ) -> Result<JointOutcome, JointError> {
@@ -97,9 +119,21 @@ pub fn calibrate_logs(
         accept_weak: true,
         ..opts.clone()
     };
+    // The nominal laser pose (first guesses of scan matching) is the first laser's:
+    // the logs of other lasers find their guesses by the bootstrap instead.
+    let other_laser = Options {
+        initial_params: None,
+        ..lenient.clone()
+    };
+    // Numbered densely from the first log's laser, whatever numbers were given.
+    let laser_of_log = crate::lasers::laser_indices(laser_of_log);
     let mut outcomes = Vec::with_capacity(logs.len());
     for (index, (name, log)) in logs.iter().enumerate() {
-        let outcome = calibrate_log(log, &lenient, progress).map_err(|source| JointError::Log {
+        let own = match laser_of_log.get(index) {
+            Some(&k) if k > 0 => &other_laser,
+            _ => &lenient,
+        };
+        let outcome = calibrate_log(log, own, progress).map_err(|source| JointError::Log {
             index,
             name: name.to_string(),
             source,
@@ -128,17 +162,39 @@ pub fn calibrate_logs(
         }));
     }
     let solve_options = opts.solve_options();
-    let mut calibration = odocal_solver::calibrate(&samples, &solve_options)
+    let laser_of: Vec<usize> = outcomes
+        .iter()
+        .zip(&laser_of_log)
+        .flat_map(|(o, &k)| std::iter::repeat_n(k, o.synced.samples.len()))
+        .collect();
+    let solved = solve(&samples, &laser_of, &solve_options)
         .map_err(|e| JointError::Joint(PipelineError::from(e).with_faults(&health)))?;
-    if let Some(check) = &synced.match_self_check {
-        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
-        odocal_solver::inflate_sigma(&mut calibration, factor);
-    }
     let agreements: Vec<Consistency> = logs
         .iter()
         .zip(&outcomes)
-        .map(|((name, _), o)| check_log(&o.calibration, &calibration, &solve_options, name))
+        .zip(&laser_of_log)
+        .map(|(((name, _), o), &k)| {
+            let view = solved.view(k);
+            let alone =
+                solved.lasers.is_some() && laser_of_log.iter().filter(|&&j| j == k).count() == 1;
+            let compared = comparison_options(&solve_options, &view, alone);
+            check_log(&o.calibration, &view, &compared, name, alone)
+        })
         .collect();
+    let Solved {
+        first: mut calibration,
+        mut lasers,
+    } = solved;
+    if let Some(check) = &synced.match_self_check {
+        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
+        odocal_solver::inflate_sigma(&mut calibration, factor);
+        if let Some(l) = lasers.as_mut().filter(|_| factor.is_finite() && factor > 1.0) {
+            l.covariance
+                .iter_mut()
+                .flatten()
+                .for_each(|v| *v *= factor * factor);
+        }
+    }
     let calibration =
         match refuse_poorly_determined(calibration, &synced, &samples, &solve_options, opts) {
             Ok(c) => c,
@@ -146,18 +202,24 @@ pub fn calibrate_logs(
                 // Logs of different robots (or mountings) make one model fit none of them:
                 // the residuals grow and the joint verdicts weaken. Name the logs that
                 // disagree rather than ask for more driving.
-                let disagreeing: Vec<String> = agreements
+                let disagreeing: Vec<(usize, String)> = agreements
                     .iter()
-                    .filter_map(|a| match a {
-                        Consistency::Checked(h) if !h.agree => Some(h.sentence.clone()),
+                    .enumerate()
+                    .filter_map(|(i, a)| match a {
+                        Consistency::Checked(h) if !h.agree => Some((i, h.sentence.clone())),
                         _ => None,
                     })
                     .collect();
                 return Err(if disagreeing.is_empty() {
                     JointError::Joint(refusal.with_faults(&health))
                 } else {
+                    let names: Vec<&str> = logs.iter().map(|(n, _)| *n).collect();
+                    let which: Vec<usize> = disagreeing.iter().map(|(i, _)| *i).collect();
+                    let mut sentences: Vec<String> =
+                        disagreeing.into_iter().map(|(_, s)| s).collect();
+                    sentences.extend(own_laser_hint(&names, &which, &laser_of_log));
                     JointError::Disagree {
-                        sentences: disagreeing.join("; "),
+                        sentences: sentences.join("; "),
                         refusal,
                     }
                 });
@@ -210,7 +272,32 @@ pub fn calibrate_logs(
         logs: outcomes,
         joint,
         contributions,
+        laser_of_log,
+        lasers,
     })
+}
+
+/// The command that gives the disagreeing logs (`which`, positions in `names`) their
+/// own laser: every disagreeing log but the first log (whose laser is the reference),
+/// or the first when it alone disagrees; `None` when the logs already have lasers of
+/// their own (several lasers: the disagreement is not the mounting).
+fn own_laser_hint(names: &[&str], which: &[usize], laser_of_log: &[usize]) -> Option<String> {
+    if laser_of_log.iter().any(|&k| k > 0) {
+        return None;
+    }
+    let mut own: Vec<usize> = which.iter().copied().filter(|&i| i > 0).collect();
+    if own.is_empty() {
+        own.push(0);
+    }
+    let flags: String = own
+        .iter()
+        .map(|i| format!(" --own-laser {}", i + 1))
+        .collect();
+    Some(format!(
+        "if the laser was mounted elsewhere for some of them, give each its own ℓ with the \
+         wheels shared (`odocal calibrate {}{flags}`, with the other options you gave)",
+        names.join(" ")
+    ))
 }
 
 /// Every log's solver samples, in log order, each log with its own read-time noise,

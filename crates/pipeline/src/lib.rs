@@ -21,7 +21,8 @@
 //! notice), [`time_offset`] (optional clock-offset search), [`options`] (what the pipeline can be told),
 //! [`synchronized`] (the per-log samples between synchronization and the solve),
 //! [`run`] (the
-//! whole, with timing), [`joint`] (several logs of one robot, one calibration) and
+//! whole, with timing), [`joint`] (several logs of one robot, one calibration), [`lasers`]
+//! (several lasers on it: the wheels shared, one ℓ per laser) and
 //! [`log_agreement`] (each of them against the joint estimate), [`samples`] (the samples and their tuples), [`estimate`] (the
 //! core numbers of a result).
 
@@ -36,6 +37,7 @@ pub mod finding;
 pub mod health;
 pub mod input_files;
 pub mod joint;
+pub mod lasers;
 pub mod log_agreement;
 pub mod match_quality;
 pub mod matching;
@@ -58,7 +60,10 @@ pub use error::PipelineError;
 pub use estimate::Estimate;
 pub use finding::{Finding, FindingKind, Severity};
 pub use input_files::InputFiles;
-pub use joint::{calibrate_logs, Contribution, JointError, JointOutcome};
+pub use joint::{
+    calibrate_logs, calibrate_logs_with_lasers, Contribution, JointError, JointOutcome,
+};
+pub use lasers::laser_indices;
 pub use odocal_solver::Trim;
 pub use options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 pub use progress::{NoProgress, Progress};

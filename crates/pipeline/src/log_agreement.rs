@@ -9,7 +9,10 @@ use nalgebra::DMatrix;
 use odocal_solver::{Calibration, SolveOptions, Verdict, PARAMETER_NAMES};
 
 /// Compares one log's own estimate `log` with the joint estimate `joint`; `name`
-/// names the log in the sentence. A log that alone does not determine every free
+/// names the log in the sentence. With `own_covariance` the difference is judged by
+/// the log's own covariance (conservative: for a log that is the only one of its
+/// laser in a joint solve of several lasers, whose `C_log − C_joint` is nearly
+/// singular and no longer the difference's covariance). A log that alone does not determine every free
 /// parameter well, or lands on the mirror solution, is not compared (the reason is
 /// given): its covariance would describe a linearization that is not valid.
 pub fn check_log(
@@ -17,6 +20,7 @@ pub fn check_log(
     joint: &Calibration,
     options: &SolveOptions,
     name: &str,
+    own_covariance: bool,
 ) -> Consistency {
     let weak: Vec<&str> = log
         .observability
@@ -46,13 +50,12 @@ pub fn check_log(
         };
     }
     let what = format!("{name} and the joint estimate");
-    let mut check = compare(
-        log,
-        joint,
-        &difference_covariance(log, joint, options),
-        options,
-        &what,
-    );
+    let covariance = if own_covariance {
+        log.covariance
+    } else {
+        difference_covariance(log, joint, options)
+    };
+    let mut check = compare(log, joint, &covariance, options, &what);
     if !check.agree {
         check.sentence = disagreement(&what, &check);
     }

@@ -102,6 +102,48 @@ pub fn laser_joint_urdf(p: &FlatParams) -> Result<String, ExportError> {
     ))
 }
 
+/// One laser of several in results.json's `lasers` (the fields export needs).
+#[derive(Debug, Clone, PartialEq, serde::Deserialize)]
+pub struct LaserPose {
+    /// The bag's scan topic, when known.
+    #[serde(default)]
+    pub topic: Option<String>,
+    /// ℓx (m).
+    pub l_x: f64,
+    /// ℓy (m).
+    pub l_y: f64,
+    /// ℓθ (rad).
+    pub l_theta: f64,
+}
+
+/// The URDF `<origin>` of every laser's joint: [`laser_joint_urdf`] with `p`'s pose
+/// when `lasers` has fewer than two; else one origin per laser, each under a comment
+/// naming it (its topic, and its position among the lasers).
+pub fn laser_joints_urdf(p: &FlatParams, lasers: &[LaserPose]) -> Result<String, ExportError> {
+    if lasers.len() < 2 {
+        return laser_joint_urdf(p);
+    }
+    let mut out = String::new();
+    for (k, l) in lasers.iter().enumerate() {
+        let one = FlatParams {
+            l_x: l.l_x,
+            l_y: l.l_y,
+            l_theta: l.l_theta,
+            ..*p
+        };
+        let origin = laser_joint_urdf(&one)?;
+        let name = l.topic.as_deref().unwrap_or("(no topic)");
+        // The topic is written inside an XML comment: no "--" may appear there.
+        out.push_str(&format!(
+            "<!-- laser {} of {}: {} -->\n{origin}",
+            k + 1,
+            lasers.len(),
+            name.replace("--", "- -")
+        ));
+    }
+    Ok(out)
+}
+
 /// Writes [`DIFF_DRIVE_FILE`] and [`URDF_FILE`] of `p` into `dir`, each atomically.
 pub fn write_ros_files(dir: &Path, p: &FlatParams) -> io::Result<()> {
     let yaml = diff_drive_controller_yaml(p).map_err(io::Error::other)?;
@@ -152,6 +194,36 @@ mod tests {
         assert!(
             urdf.contains("<origin xyz=\"-0.0058 0.0002 0\" rpy=\"0 0 0.0095\"/>"),
             "{urdf}"
+        );
+    }
+
+    #[test]
+    fn one_origin_per_laser() {
+        let lasers = [
+            LaserPose {
+                topic: Some("/scan_front".into()),
+                l_x: 0.1,
+                l_y: 0.0,
+                l_theta: 0.0,
+            },
+            LaserPose {
+                topic: Some("/scan_rear".into()),
+                l_x: -0.2,
+                l_y: 0.01,
+                l_theta: 3.1,
+            },
+        ];
+        let urdf = laser_joints_urdf(&params(), &lasers).unwrap();
+        assert_eq!(urdf.matches("<origin ").count(), 2, "{urdf}");
+        assert!(urdf.contains("laser 2 of 2: /scan_rear"), "{urdf}");
+        assert!(
+            urdf.contains("<origin xyz=\"-0.2 0.01 0\" rpy=\"0 0 3.1\"/>"),
+            "{urdf}"
+        );
+        // One laser: the single origin of the six-parameter fields.
+        assert_eq!(
+            laser_joints_urdf(&params(), &lasers[..1]).unwrap(),
+            laser_joint_urdf(&params()).unwrap()
         );
     }
 

@@ -16,9 +16,10 @@ use serde_json::Value;
 const CSS: &str = include_str!("report.css");
 
 /// Top-level results.json keys shown in a section of their own.
-const SHOWN: [&str; 17] = [
+const SHOWN: [&str; 18] = [
     "log",
     "logs",
+    "lasers",
     "r_l",
     "r_r",
     "b",
@@ -267,7 +268,7 @@ fn ros_terms(r: &Report) -> Markup {
         ),
         (
             crate::export::URDF_FILE,
-            crate::export::laser_joint_urdf(&r.params),
+            crate::export::laser_joints_urdf(&r.params, &r.laser_poses()),
         ),
     ];
     html! {
@@ -353,6 +354,13 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
                         h2 { "Logs calibrated together" }
                         p { "Each log's own estimate (own, own σ; m, rad), the samples it brought, its share of the information on r_L, r_R, b, ℓx, ℓy, ℓθ, and χ² of its own estimate against the joint one (agree: within 3σ)." }
                         (json(logs, "/logs"))
+                    }
+                }
+                @if let Some(lasers) = v.get("lasers") {
+                    section #lasers {
+                        h2 { "Lasers" }
+                        p { "One row per laser, the wheels shared: its pose ℓ (m, rad) with σ and covariance from the joint covariance, the logs and samples it brought, and its pose in the first laser's frame (from_first: ℓ₁⁻¹ ⊕ ℓ, with its covariance)." }
+                        (json(lasers, "/lasers"))
                     }
                 }
                 (ros_terms(r))

@@ -44,45 +44,203 @@ pub struct LogRow {
     pub disagreeing: Vec<String>,
 }
 
-/// The report of `joint`, the joint calibration of `logs` read from `paths`.
+/// One laser of a robot with several: its pose with the shared wheels, and its pose
+/// in the first laser's frame.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LaserRow {
+    /// The bag's scan topic, when the laser's logs are bags.
+    pub topic: Option<String>,
+    /// The logs (names as in `logs`) whose samples are this laser's.
+    pub logs: Vec<String>,
+    /// ℓx (m).
+    pub l_x: f64,
+    /// ℓy (m).
+    pub l_y: f64,
+    /// ℓθ (rad).
+    pub l_theta: f64,
+    /// σ of (ℓx, ℓy, ℓθ).
+    pub sigma: [f64; 3],
+    /// Covariance of (ℓx, ℓy, ℓθ) from the joint covariance.
+    pub covariance: [[f64; 3]; 3],
+    /// Samples of this laser handed to the solve.
+    pub samples: usize,
+    /// Of them, the samples the joint estimate used.
+    pub samples_used: usize,
+    /// The laser's pose in the first laser's frame, `ℓ₁⁻¹ ⊕ ℓ_k`, with its covariance
+    /// (from the joint covariance of ℓ₁ and ℓ_k, cross terms included); identity with
+    /// zero covariance for the first laser.
+    pub from_first: Between,
+}
+
+impl Report {
+    /// Every laser's pose for export (empty with one laser).
+    pub fn laser_poses(&self) -> Vec<crate::export::LaserPose> {
+        self.lasers
+            .iter()
+            .map(|l| crate::export::LaserPose {
+                topic: l.topic.clone(),
+                l_x: l.l_x,
+                l_y: l.l_y,
+                l_theta: l.l_theta,
+            })
+            .collect()
+    }
+}
+
+/// A pose relative to the first laser, with its covariance.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Between {
+    /// x (m) in the first laser's frame.
+    pub x: f64,
+    /// y (m).
+    pub y: f64,
+    /// Heading (rad).
+    pub theta: f64,
+    /// σ of (x, y, θ).
+    pub sigma: [f64; 3],
+    /// Covariance of (x, y, θ).
+    pub covariance: [[f64; 3]; 3],
+}
+
+/// The per-laser rows of a joint estimate with several lasers; `names` are the logs'
+/// names and `topics` their bag scan topics, in the order of `joint.laser_of_log`.
+pub fn laser_rows(
+    joint: &JointOutcome,
+    names: &[String],
+    topics: &[Option<String>],
+) -> Vec<LaserRow> {
+    let Some(lasers) = &joint.lasers else {
+        return Vec::new();
+    };
+    (0..lasers.lasers())
+        .map(|k| {
+            let mine: Vec<usize> = (0..joint.laser_of_log.len())
+                .filter(|&i| joint.laser_of_log[i] == k)
+                .collect();
+            let p = lasers.params_of(k).laser;
+            let c6 = lasers.covariance_of(k);
+            let covariance: [[f64; 3]; 3] =
+                std::array::from_fn(|i| std::array::from_fn(|j| c6[3 + i][3 + j]));
+            let (t, tc) = lasers.from_first(k);
+            let sigma = |c: &[[f64; 3]; 3]| std::array::from_fn(|i| c[i][i].max(0.0).sqrt());
+            LaserRow {
+                topic: mine.iter().find_map(|&i| topics.get(i).cloned().flatten()),
+                logs: mine.iter().filter_map(|&i| names.get(i).cloned()).collect(),
+                l_x: p.x,
+                l_y: p.y,
+                l_theta: p.theta,
+                sigma: sigma(&covariance),
+                covariance,
+                samples: mine.iter().map(|&i| joint.contributions[i].samples).sum(),
+                samples_used: mine
+                    .iter()
+                    .map(|&i| joint.contributions[i].samples_used)
+                    .sum(),
+                from_first: Between {
+                    x: t.x,
+                    y: t.y,
+                    theta: t.theta,
+                    sigma: sigma(&tc),
+                    covariance: tc,
+                },
+            }
+        })
+        .collect()
+}
+
+/// The per-laser lines of the human summary.
+pub(crate) fn write_laser_table(f: &mut fmt::Formatter<'_>, rows: &[LaserRow]) -> fmt::Result {
+    writeln!(
+        f,
+        "  per laser (wheels shared; ℓ ± σ, and the pose in laser 1's frame):"
+    )?;
+    for (k, r) in rows.iter().enumerate() {
+        let name = r.topic.clone().unwrap_or_else(|| r.logs.join(", "));
+        write!(
+            f,
+            "    laser {} {}: ℓx {:+.2} ± {:.2} mm, ℓy {:+.2} ± {:.2} mm, ℓθ {:+.3}° ± {:.3}° \
+             ({} samples, {} used)",
+            k + 1,
+            name,
+            r.l_x * 1e3,
+            r.sigma[0] * 1e3,
+            r.l_y * 1e3,
+            r.sigma[1] * 1e3,
+            r.l_theta.to_degrees(),
+            r.sigma[2].to_degrees(),
+            r.samples,
+            r.samples_used
+        )?;
+        let b = &r.from_first;
+        if k > 0 {
+            write!(
+                f,
+                "; from laser 1: x {:+.2} ± {:.2} mm, y {:+.2} ± {:.2} mm, θ {:+.3}° ± {:.3}°",
+                b.x * 1e3,
+                b.sigma[0] * 1e3,
+                b.y * 1e3,
+                b.sigma[1] * 1e3,
+                b.theta.to_degrees(),
+                b.sigma[2].to_degrees()
+            )?;
+        }
+        writeln!(f)?;
+    }
+    Ok(())
+}
+
+/// The report of `joint`, the joint calibration of `logs` read from `paths` and named
+/// `names` in the messages and rows (a bag read for several lasers is one name per
+/// scan topic); `topics` are the logs' bag scan topics (`None` for text logs).
 pub fn build_joint_report(
     paths: &[&Path],
+    names: &[String],
+    topics: &[Option<String>],
     logs: &[&Log],
     opts: &Options,
     joint: &JointOutcome,
 ) -> Report {
     let mut report = build_report(paths[0], logs[0], opts, &joint.joint);
-    report.log = paths
-        .iter()
-        .map(|p| p.display().to_string())
-        .collect::<Vec<_>>()
-        .join(" + ");
+    let mut distinct: Vec<String> = Vec::new();
+    for p in paths {
+        let p = p.display().to_string();
+        if !distinct.contains(&p) {
+            distinct.push(p);
+        }
+    }
+    report.log = distinct.join(" + ");
+    report.lasers = laser_rows(joint, names, topics);
     let c = &mut report.log_contents;
-    for log in &logs[1..] {
+    for (i, log) in logs.iter().enumerate().skip(1) {
         c.scans += log.scans.len();
+        // A bag read once per laser holds its wheel data once.
+        if paths[..i].contains(&paths[i]) {
+            continue;
+        }
         c.encoder_records += log.encoders.len();
         c.skipped_lines += log.stats.skipped_lines;
         c.unknown_messages += log.stats.unknown.values().sum::<u64>();
     }
+    let files = Files::new(paths, names, topics);
     report.checks = joint
         .contributions
         .iter()
-        .zip(paths)
-        .map(|(c, path)| agreement_finding(&c.agreement, path))
+        .enumerate()
+        .map(|(i, c)| agreement_finding(&c.agreement, i, names, &files, joint))
         .collect();
     report.logs = joint
         .contributions
         .iter()
         .zip(&joint.logs)
-        .zip(paths)
-        .map(|((c, o), path)| {
+        .zip(names)
+        .map(|((c, o), name)| {
             let own = Estimate::of(o);
             let checked = match &c.agreement {
                 Consistency::Checked(h) => Some(h),
                 Consistency::NotAvailable { .. } => None,
             };
             LogRow {
-                path: path.display().to_string(),
+                path: name.clone(),
                 sha256: None,
                 time_offset_s: o.synced.time_offset,
                 samples: c.samples,
@@ -100,25 +258,101 @@ pub fn build_joint_report(
     report
 }
 
-/// One log's agreement as a finding: a warning, with what to do, when it disagrees.
-fn agreement_finding(agreement: &Consistency, path: &Path) -> Finding {
+/// One log's agreement as a finding: a warning, with what to do, when it disagrees:
+/// log `index` of `names` (`files` are the log files given, `file_of[i]` the file of
+/// log `i`; `joint` says which logs share a laser).
+fn agreement_finding(
+    agreement: &Consistency,
+    index: usize,
+    names: &[String],
+    files: &Files,
+    joint: &JointOutcome,
+) -> Finding {
+    let name = &names[index];
     match agreement {
         Consistency::Checked(h) if h.agree => {
             Finding::note(FindingKind::LogAgreement, h.sentence.clone())
         }
-        Consistency::Checked(h) => Finding::warning(
-            FindingKind::LogAgreement,
-            format!(
-                "{}; if {} was recorded with the laser mounted elsewhere, on another floor or \
-                 on another robot, calibrate without it, or on its own (`odocal calibrate {}`)",
-                h.sentence,
-                path.display(),
-                path.display()
-            ),
-        ),
+        Consistency::Checked(h) => {
+            let laser = joint.laser_of_log.get(index).copied().unwrap_or(0);
+            let shares_laser = joint
+                .laser_of_log
+                .iter()
+                .enumerate()
+                .any(|(i, &k)| k == laser && files.file_of[i] != files.file_of[index]);
+            let own = if shares_laser {
+                format!(
+                    "if {name}'s laser was mounted elsewhere, give it its own ℓ (`{}`, with \
+                     the other options you gave); ",
+                    files.own_laser_command(files.file_of[index])
+                )
+            } else {
+                String::new()
+            };
+            let file = &files.files[files.file_of[index]];
+            Finding::warning(
+                FindingKind::LogAgreement,
+                format!(
+                    "{}; {own}if it was recorded on another floor or on another robot, \
+                     calibrate without it, or on its own (`odocal calibrate {file}`)",
+                    h.sentence
+                ),
+            )
+        }
         Consistency::NotAvailable { reason } => {
             Finding::note(FindingKind::LogAgreement, reason.clone())
         }
+    }
+}
+
+/// The log files of a joint calibration and the scan topics read from them.
+struct Files {
+    /// Each file once, in the order given.
+    files: Vec<String>,
+    /// Per log: its file's index in `files`.
+    file_of: Vec<usize>,
+    /// The scan topics when a bag was read for several (each once).
+    topics: Vec<String>,
+}
+
+impl Files {
+    fn new(paths: &[&Path], names: &[String], topics: &[Option<String>]) -> Files {
+        let mut files: Vec<String> = Vec::new();
+        let file_of = paths
+            .iter()
+            .map(|p| {
+                let p = p.display().to_string();
+                match files.iter().position(|f| *f == p) {
+                    Some(i) => i,
+                    None => {
+                        files.push(p);
+                        files.len() - 1
+                    }
+                }
+            })
+            .collect();
+        let several = names.len() > files.len();
+        let mut listed: Vec<String> = Vec::new();
+        for t in topics.iter().flatten() {
+            if several && !listed.contains(t) {
+                listed.push(t.clone());
+            }
+        }
+        Files {
+            files,
+            file_of,
+            topics: listed,
+        }
+    }
+
+    /// `odocal calibrate FILES… [--scan-topic T…] --own-laser N` for file `file`.
+    fn own_laser_command(&self, file: usize) -> String {
+        let mut cmd = format!("odocal calibrate {}", self.files.join(" "));
+        for t in &self.topics {
+            cmd.push_str(&format!(" --scan-topic {t}"));
+        }
+        cmd.push_str(&format!(" --own-laser {}", file + 1));
+        cmd
     }
 }
 

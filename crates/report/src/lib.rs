@@ -26,8 +26,10 @@ pub mod output;
 pub mod provenance;
 pub mod report;
 
-pub use export::{diff_drive_controller_yaml, laser_joint_urdf, write_ros_files};
-pub use joint::{build_joint_report, LogRow};
+pub use export::{
+    diff_drive_controller_yaml, laser_joint_urdf, laser_joints_urdf, write_ros_files, LaserPose,
+};
+pub use joint::{build_joint_report, laser_rows, Between, LaserRow, LogRow};
 pub use odocal_pipeline::{Finding, FindingKind, Severity};
 pub use output::{html_report, is_output_name, write_html, write_outputs};
 pub use provenance::{sha256_of_input, Provenance};

@@ -2,7 +2,7 @@
 //! results in ROS terms — diff_drive_controller.yaml and laser_joint.urdf.xml — and,
 //! with `--plots`, one SVG per figure) and by `--report FILE.html`.
 
-use crate::export::{diff_drive_controller_yaml, laser_joint_urdf, DIFF_DRIVE_FILE, URDF_FILE};
+use crate::export::{diff_drive_controller_yaml, laser_joints_urdf, DIFF_DRIVE_FILE, URDF_FILE};
 use crate::figures::{figures, Figure};
 use crate::html::page;
 use crate::report::Report;
@@ -64,7 +64,7 @@ pub fn write_outputs(
     let json = serde_json::to_string_pretty(report).map_err(io::Error::other)?;
     let figs = drawn(opts, outcome, report)?;
     let ros_yaml = diff_drive_controller_yaml(&report.params);
-    let ros_urdf = laser_joint_urdf(&report.params);
+    let ros_urdf = laser_joints_urdf(&report.params, &report.laser_poses());
     write_dir_atomically(dir, &is_output_name, |fresh| {
         write_bytes_atomically(&fresh.join("results.json"), (json + "\n").as_bytes())?;
         write_tuples(&fresh.join("samples.tuple"), &outcome.synced.samples)?;

@@ -107,6 +107,10 @@ pub struct Report {
     /// With several logs calibrated together: one row per log.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub logs: Vec<crate::joint::LogRow>,
+    /// With several lasers on the robot: one row per laser (the six-parameter fields
+    /// above are the first laser's).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub lasers: Vec<crate::joint::LaserRow>,
 }
 
 /// A nominal laser pose read from the input (a bag's static transforms).
@@ -261,6 +265,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         },
         timing_s: e.timing_s,
         logs: Vec::new(),
+        lasers: Vec::new(),
     }
 }
 
@@ -440,6 +445,9 @@ impl fmt::Display for Report {
         }
         if !self.logs.is_empty() {
             crate::joint::write_log_table(f, &self.logs)?;
+        }
+        if !self.lasers.is_empty() {
+            crate::joint::write_laser_table(f, &self.lasers)?;
         }
         for finding in &self.checks {
             writeln!(f, "  {finding}")?;

@@ -16,7 +16,8 @@
 //! 5. covariance (inverse Fisher information with analytic Jacobians) and an
 //!    [`Observability`] report; degenerate data give [`SolveError::NotExcited`].
 //!
-//! Entry point: [`calibrate`].
+//! Entry point: [`calibrate`]; for a robot with several lasers (wheels shared, one ℓ
+//! per laser), [`calibrate_lasers`].
 //!
 //! ```
 //! use odocal_geom::Pose2;
@@ -48,6 +49,7 @@ mod covariance;
 mod error;
 mod inflate;
 mod kinematics;
+mod lasers;
 mod linalg;
 mod noise;
 mod normal_equations;
@@ -73,6 +75,7 @@ pub use covariance::INFORMATION_SINGULAR_RATIO;
 pub use error::SolveError;
 pub use inflate::inflate_sigma;
 pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
+pub use lasers::{calibrate_lasers, LasersCalibration};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
 pub use observability::{
     MotionContent, Observability, ParameterReport, Verdict, MOTION_CLASS_RATIO,

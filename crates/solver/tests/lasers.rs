@@ -1,0 +1,196 @@
+//! Several lasers on one robot (`calibrate_lasers`): exact recovery of the shared
+//! wheels and of each laser's pose on noise-free data, agreement with the
+//! single-laser solve for one laser, and statistical consistency of the joint
+//! covariance and of the laser-to-laser transform on noisy data.
+
+#![allow(clippy::needless_range_loop)]
+
+mod common;
+
+use common::{add_noise, exact_samples, rng, test_robot};
+use nalgebra::DMatrix;
+use odocal_geom::Pose2;
+use odocal_solver::{calibrate, calibrate_lasers, Params, Sample, SolveOptions};
+use rand::rngs::StdRng;
+
+/// The test robot's wheels with a front laser and a rear laser turned by π.
+fn two_lasers() -> (Params, Params) {
+    let front = test_robot();
+    let rear = Params {
+        laser: Pose2::new(-0.12, 0.02, std::f64::consts::PI - 0.05),
+        ..front
+    };
+    (front, rear)
+}
+
+/// `n` samples of each laser (noise `sigma` on ŝ when given), with their laser index.
+fn drive(
+    r: &mut StdRng,
+    lasers: &[Params],
+    n: usize,
+    sigma: Option<[f64; 3]>,
+) -> (Vec<Sample>, Vec<usize>) {
+    let mut samples = Vec::new();
+    let mut laser_of = Vec::new();
+    for (k, p) in lasers.iter().enumerate() {
+        let mut s = exact_samples(r, p, n, 1);
+        if let Some(sigma) = sigma {
+            add_noise(r, &mut s, sigma);
+        }
+        laser_of.extend(std::iter::repeat_n(k, s.len()));
+        samples.extend(s);
+    }
+    (samples, laser_of)
+}
+
+fn truth_vector(lasers: &[Params]) -> Vec<f64> {
+    let mut v = vec![lasers[0].r_l, lasers[0].r_r, lasers[0].b];
+    for p in lasers {
+        v.extend([p.laser.x, p.laser.y, p.laser.theta]);
+    }
+    v
+}
+
+fn angle_diff(a: f64, b: f64) -> f64 {
+    odocal_geom::wrap_angle(a - b)
+}
+
+#[test]
+fn noise_free_two_lasers_recovered_exactly() {
+    let (front, rear) = two_lasers();
+    let (samples, laser_of) = drive(&mut rng(1), &[front, rear], 90, None);
+    let cal = calibrate_lasers(&samples, &laser_of, &SolveOptions::default()).unwrap();
+    assert_eq!(cal.lasers(), 2);
+    let truth = truth_vector(&[front, rear]);
+    for (i, (got, want)) in cal.params.iter().zip(&truth).enumerate() {
+        let err = if i % 3 == 2 && i >= 3 {
+            angle_diff(*got, *want)
+        } else {
+            got - want
+        };
+        assert!(err.abs() < 1e-9, "parameter {i}: {got} vs {want}");
+    }
+    let (t, _) = cal.from_first(1);
+    let want = front.laser.inverse().compose(&rear.laser);
+    assert!((t.x - want.x).abs() < 1e-9 && (t.y - want.y).abs() < 1e-9);
+    assert!(angle_diff(t.theta, want.theta).abs() < 1e-9);
+    // The first laser's view: the shared wheels and ℓ₁.
+    assert!((cal.first.params.b - front.b).abs() < 1e-9);
+    assert!((cal.first.params.laser.x - front.laser.x).abs() < 1e-9);
+}
+
+#[test]
+fn one_laser_agrees_with_the_single_laser_solve() {
+    let mut r = rng(2);
+    let mut samples = exact_samples(&mut r, &test_robot(), 200, 1);
+    add_noise(&mut r, &mut samples, [0.002, 0.002, 0.004]);
+    let single = calibrate(&samples, &SolveOptions::default()).unwrap();
+    let joint =
+        calibrate_lasers(&samples, &vec![0; samples.len()], &SolveOptions::default()).unwrap();
+    let sigma = |i: usize| single.covariance[i][i].sqrt();
+    for (i, v) in single.params.to_vector().iter().enumerate() {
+        assert!(
+            (joint.params[i] - v).abs() < 1e-6 * sigma(i),
+            "parameter {i}: {} vs {v}",
+            joint.params[i]
+        );
+        let ratio = joint.covariance[i][i].sqrt() / sigma(i);
+        assert!(
+            (ratio - 1.0).abs() < 1e-6,
+            "σ of parameter {i}: ratio {ratio}"
+        );
+    }
+    assert_eq!(joint.used, single.used);
+}
+
+/// Normalized estimation error squared of `err` under `cov`.
+fn nees(err: &[f64], cov: &DMatrix<f64>) -> f64 {
+    let e = nalgebra::DVector::from_column_slice(err);
+    let inv = cov.clone().try_inverse().expect("covariance invertible");
+    (e.transpose() * inv * e)[0]
+}
+
+/// Mean NEES of the 9 joint parameters and of the 3 of the laser-to-laser transform
+/// over `runs` noisy drives, and the ratio of the joint σ of b to the best single
+/// laser's.
+fn monte_carlo(runs: usize, seed: u64) -> (f64, f64, f64) {
+    let (front, rear) = two_lasers();
+    let truth = truth_vector(&[front, rear]);
+    let want = front.laser.inverse().compose(&rear.laser);
+    let mut r = rng(seed);
+    let (mut joint_sum, mut between_sum, mut ratio_sum) = (0.0, 0.0, 0.0);
+    for _ in 0..runs {
+        let (samples, laser_of) = drive(&mut r, &[front, rear], 150, Some([0.002, 0.002, 0.004]));
+        let cal = calibrate_lasers(&samples, &laser_of, &SolveOptions::default()).unwrap();
+        let err: Vec<f64> = (0..9)
+            .map(|i| {
+                if i == 5 || i == 8 {
+                    angle_diff(cal.params[i], truth[i])
+                } else {
+                    cal.params[i] - truth[i]
+                }
+            })
+            .collect();
+        let cov = DMatrix::from_fn(9, 9, |i, j| cal.covariance[i][j]);
+        joint_sum += nees(&err, &cov);
+        let (t, c) = cal.from_first(1);
+        let e = [t.x - want.x, t.y - want.y, angle_diff(t.theta, want.theta)];
+        between_sum += nees(&e, &DMatrix::from_fn(3, 3, |i, j| c[i][j]));
+        let best_single = cal
+            .own
+            .iter()
+            .map(|o| o.covariance[2][2].sqrt())
+            .fold(f64::INFINITY, f64::min);
+        ratio_sum += cal.covariance[2][2].sqrt() / best_single;
+    }
+    let n = runs as f64;
+    (joint_sum / n, between_sum / n, ratio_sum / n)
+}
+
+#[test]
+fn noisy_two_lasers_consistent_short() {
+    let runs = 40;
+    let (joint, between, ratio) = monte_carlo(runs, 3);
+    // χ²(9) mean 9, sd of the mean √(18/runs); χ²(3) mean 3, sd √(6/runs); 3.5 sd.
+    let half9 = 3.5 * (18.0 / runs as f64).sqrt();
+    let half3 = 3.5 * (6.0 / runs as f64).sqrt();
+    assert!(
+        (joint - 9.0).abs() < half9,
+        "mean NEES of the joint {joint}"
+    );
+    assert!(
+        (between - 3.0).abs() < half3,
+        "mean NEES of ℓ₁⁻¹⊕ℓ₂ {between}"
+    );
+    // Twice the wheel data: b's σ about 1/√2 of one laser's.
+    assert!(ratio < 0.8, "joint σ_b / best single σ_b = {ratio}");
+}
+
+#[test]
+#[ignore = "Monte Carlo, 300 runs (0.2 s in release; kept with the other Monte Carlo suites)"]
+fn noisy_two_lasers_consistent_long() {
+    let runs = 300;
+    let (joint, between, ratio) = monte_carlo(runs, 4);
+    let half9 = 3.5 * (18.0 / runs as f64).sqrt();
+    let half3 = 3.5 * (6.0 / runs as f64).sqrt();
+    println!("mean NEES joint {joint:.3} (9), between {between:.3} (3), σ_b ratio {ratio:.3}");
+    assert!(
+        (joint - 9.0).abs() < half9,
+        "mean NEES of the joint {joint}"
+    );
+    assert!(
+        (between - 3.0).abs() < half3,
+        "mean NEES of ℓ₁⁻¹⊕ℓ₂ {between}"
+    );
+    assert!(ratio < 0.8);
+}
+
+#[test]
+fn laser_without_samples_is_an_error_not_a_panic() {
+    let (front, _) = two_lasers();
+    let samples = exact_samples(&mut rng(5), &front, 30, 1);
+    // Laser 1 named but given no samples.
+    let mut laser_of = vec![0; samples.len()];
+    laser_of[0] = 2;
+    assert!(calibrate_lasers(&samples, &laser_of, &SolveOptions::default()).is_err());
+}
