@@ -68,6 +68,10 @@ pub struct PreparedScan {
     /// |cos| of the incidence angle of each ray on its own surface (mean over the
     /// usable segments at the point), NaN when the point has no usable segment.
     pub(crate) incidence_cos: Vec<f64>,
+    /// Readings without a return (zero, non-finite or below the minimum range: dark,
+    /// glancing or transparent surfaces), as opposed to valid ones and to readings
+    /// beyond the maximum range (a far surface was seen).
+    pub(crate) no_return: Vec<bool>,
     /// Indices of the valid readings, increasing.
     pub(crate) valid_indices: Vec<u32>,
     /// Valid readings on a usable local line (finite `incidence_cos`): the points a
@@ -232,6 +236,7 @@ impl PreparedScan {
             sides,
             points,
             valid,
+            no_return: no_returns(ranges, lo),
             incidence_cos,
             valid_indices,
             lined_count,
@@ -289,6 +294,14 @@ impl PreparedScan {
             (i as usize).min(n - 1)
         }
     }
+}
+
+/// `no_return[i]`: reading `i` is zero, non-finite or at most `lo` (m).
+fn no_returns(ranges: &[f32], lo: f64) -> Vec<bool> {
+    ranges
+        .iter()
+        .map(|&r| !r.is_finite() || f64::from(r) <= lo)
+        .collect()
 }
 
 /// Unit directions of the rays. For uniformly spaced angles (every laser) they are

@@ -97,6 +97,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Ok(v) = std::env::var("SHARE") {
         icp.min_matched_share = v.parse()?;
     }
+    if let Ok(v) = std::env::var("MAXR") {
+        icp.max_reading = v.parse()?;
+    }
     let results = match_pairs(&store, &pairs, &guesses, &icp, || {});
     let mut tally: BTreeMap<String, usize> = BTreeMap::new();
     let mut ok = 0;
