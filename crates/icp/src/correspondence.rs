@@ -181,7 +181,8 @@ mod tests {
     use crate::IcpParams;
 
     /// A wall at y = 2 m seen by 181 rays over 90°, with the readings `gap` missing
-    /// (0: no return), or replaced by `jump` (m: a far surface).
+    /// (0: no return), or replaced by `jump` (m: a far surface); the last 20 rays got
+    /// no return either (a sparse scan: missing returns are common).
     fn wall_with_gap(gap: std::ops::Range<usize>, jump: Option<f32>) -> PreparedScan {
         let angles: Vec<f64> = (0..181)
             .map(|i| (45.0 + i as f64 * 0.5).to_radians())
@@ -190,6 +191,7 @@ mod tests {
             .iter()
             .enumerate()
             .map(|(i, a)| match (gap.contains(&i), jump) {
+                _ if i > 160 => 0.0,
                 (false, _) => (2.0 / a.sin()) as f32,
                 (true, None) => 0.0,
                 (true, Some(far)) => far,
@@ -227,6 +229,24 @@ mod tests {
         // Far past the end (5 segment lengths): unseen, no correspondence.
         let (p, j) = on_wall(&scan, -0.07);
         assert_eq!(segment_for(&scan, p, j), None, "ray {j}");
+    }
+
+    #[test]
+    fn a_run_ending_at_a_rare_dropout_is_not_followed() {
+        // The same gap in a scan that has no other missing reading: a dropout.
+        let angles: Vec<f64> = (0..181)
+            .map(|i| (45.0 + i as f64 * 0.5).to_radians())
+            .collect();
+        let ranges: Vec<f32> = angles
+            .iter()
+            .enumerate()
+            .map(|(i, a)| if i == 90 { 0.0 } else { (2.0 / a.sin()) as f32 })
+            .collect();
+        let scan =
+            PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).expect("scan");
+        let (p, j) = on_wall(&scan, 0.008);
+        assert_eq!(j, 89);
+        assert_eq!(segment_for(&scan, p, j), None);
     }
 
     #[test]
