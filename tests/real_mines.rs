@@ -20,14 +20,15 @@ fn mines_log(name: &str) -> Option<PathBuf> {
 
 #[test]
 fn most_pairs_of_the_real_mines_logs_match_and_every_refusal_has_its_reason() {
-    // (log, share of the moving pairs matched at least): measured 109/175 (62 %) and
-    // 80/147 (54 %). Before: 89/175 and 66/147; 101/175 and 73/147 once runs ending at
-    // readings without a return are followed a little further; the rest since the
-    // second pass also tries again the pairs the first refused (first guesses from a
-    // rough estimate at the starting clock offset, 0.19 s off). docs/benchmarks.md.
+    // (log, share of the moving pairs matched at least): measured 101/175 (58 %) and
+    // 73/147 (50 %) since runs ending at readings without a return are followed a
+    // little further in sparse scans (89/175 and 66/147 before; docs/benchmarks.md).
     // A visibility-aware overlap gave more but accepted wrong matches in the basin
-    // grid, and was withdrawn: the yield target of issue 20 (80 %) is not met.
-    for (name, min_yield) in [("exp1.log", 0.61), ("exp2.log", 0.53)] {
+    // grid, and was withdrawn; matching the refused pairs again in the second pass
+    // gave 109 and 80 but made fixtures/bags/turtlebot_tf.bag pass as well determined
+    // with l_x 5 sigma off its truth, and was withdrawn: the yield target of issue 20
+    // (80 %) is not met.
+    for (name, min_yield) in [("exp1.log", 0.56), ("exp2.log", 0.48)] {
         let Some(path) = mines_log(name) else { return };
         let log = odocal_log::read_log(&path, &Default::default()).unwrap();
         let opts = Options {
@@ -40,16 +41,6 @@ fn most_pairs_of_the_real_mines_logs_match_and_every_refusal_has_its_reason() {
             .discarded
             .get(odocal_pipeline::sync::DiscardReason::MatchFailed);
         assert_eq!(synced.match_rejections.total(), failed, "{name}");
-        // Every refused pair is kept, with its reason, for the second pass.
-        assert_eq!(synced.refused.len(), failed, "{name}");
-        for reason in Rejection::ALL {
-            let kept = synced.refused.iter().filter(|r| r.1 == reason).count();
-            assert_eq!(
-                kept,
-                synced.match_rejections.get(reason),
-                "{name}: {reason:?}"
-            );
-        }
         let matched = synced.samples.len();
         let share = matched as f64 / (matched + failed) as f64;
         println!(

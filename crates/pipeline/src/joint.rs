@@ -256,8 +256,6 @@ fn merged(outcomes: &[Outcome]) -> Synchronized {
     let first = &outcomes[0].synced;
     Synchronized {
         match_rejections,
-        // Pairs of different logs: nothing to match again here.
-        refused: Vec::new(),
         match_self_check: pooled_self_check(outcomes),
         stride: first.stride,
         limits: first.limits,

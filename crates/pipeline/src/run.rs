@@ -258,7 +258,6 @@ pub fn synchronize_and_match(
 
     let mut samples = Vec::with_capacity(kept.len());
     let mut match_rejections = RejectionCounts::default();
-    let mut refused = Vec::new();
     for (((k, wheel), m), uncovered) in kept.into_iter().zip(matched).zip(uncovered) {
         match m.unwrap_or_else(|| Err(MatchFailure::new(Rejection::Other, "not matched"))) {
             Ok(icp) => samples.push(PairSample {
@@ -270,7 +269,6 @@ pub fn synchronize_and_match(
             Err(f) => {
                 discarded.add(DiscardReason::MatchFailed);
                 match_rejections.add(f.reason);
-                refused.push((pairs[k], f.reason));
             }
         }
     }
@@ -283,7 +281,6 @@ pub fn synchronize_and_match(
         samples,
         discarded,
         match_rejections,
-        refused,
         match_self_check,
         time_offset: opts.time_offset,
         sweep_compensated,
@@ -294,11 +291,7 @@ pub fn synchronize_and_match(
 
 /// Matches the samples again with first guesses from `params` — and, when the scans
 /// were swept, after compensating the sweep with `params` (samples whose sweeps the
-/// encoders do not cover are discarded as encoder gaps). The pairs the matcher
-/// refused before are tried again too, with their wheel motion at the offset now
-/// used: the first pass guessed them from a rough estimate at the starting clock
-/// offset (on the MinesRover logs 0.19 s off), and a refusal there is often a guess
-/// too far off, or a sweep compensated with the wrong motion.
+/// encoders do not cover are discarded as encoder gaps).
 fn second_pass(
     log: &Log,
     synced: &mut Synchronized,
@@ -306,36 +299,20 @@ fn second_pass(
     opts: &Options,
     progress: &dyn Progress,
 ) {
-    let track = EncoderTrack::new(&log.encoders, synced.ticks_per_revolution);
-    let offset = synced.time_offset;
-    // The refused pairs that still synchronize at the offset now used.
-    let retried: Vec<(ScanPair, Rejection, WheelMotion)> = std::mem::take(&mut synced.refused)
-        .into_iter()
-        .filter_map(|(pair, reason)| {
-            match track.motion(pair.t0 - offset, pair.t1 - offset, &synced.limits) {
-                Ok(wheel) => Some((pair, reason, wheel)),
-                Err(_) => {
-                    synced.refused.push((pair, reason));
-                    None
-                }
-            }
-        })
-        .collect();
     let motions: Vec<(usize, WheelMotion)> = synced
         .samples
         .iter()
-        .map(|s| s.wheel.clone())
-        .chain(retried.iter().map(|r| r.2.clone()))
         .enumerate()
+        .map(|(k, s)| (k, s.wheel.clone()))
         .collect();
     let guesses = first_guesses(&motions, Some(params), opts.use_profile);
     let index_pairs: Vec<(usize, usize)> = synced
         .samples
         .iter()
         .map(|s| (s.pair.first, s.pair.second))
-        .chain(retried.iter().map(|r| (r.0.first, r.0.second)))
         .collect();
     let (scans, covered) = if has_sweep(&log.scans) {
+        let track = EncoderTrack::new(&log.encoders, synced.ticks_per_revolution);
         let (store, covered) = compensated_pairs(
             &log.scans,
             &index_pairs,
@@ -350,17 +327,11 @@ fn second_pass(
         (Cow::Borrowed(&log.scans), vec![true; index_pairs.len()])
     };
     progress.start("matching (second pass)", index_pairs.len());
-    let mut matched: Vec<Result<MatchStats, MatchFailure>> =
+    let matched: Vec<Result<MatchStats, MatchFailure>> =
         match_pairs(&scans, &index_pairs, &guesses, &opts.icp, || {
             progress.advance()
         });
     progress.finish();
-    let again = matched.split_off(synced.samples.len());
-    let (again_covered, covered) = {
-        let mut c = covered;
-        let rest = c.split_off(synced.samples.len());
-        (rest, c)
-    };
     let old = std::mem::take(&mut synced.samples);
     for ((s, m), covered) in old.into_iter().zip(matched).zip(covered) {
         match m {
@@ -369,42 +340,8 @@ fn second_pass(
             Err(f) => {
                 synced.discarded.add(DiscardReason::MatchFailed);
                 synced.match_rejections.add(f.reason);
-                synced.refused.push((s.pair, f.reason));
             }
         }
-    }
-    let mut recovered = false;
-    for (((pair, reason, wheel), m), covered) in retried.into_iter().zip(again).zip(again_covered) {
-        match m {
-            Ok(icp) if covered => {
-                uncount(&mut synced.discarded.0, DiscardReason::MatchFailed.key());
-                uncount(&mut synced.match_rejections.0, reason.key());
-                synced.samples.push(PairSample { pair, wheel, icp });
-                recovered = true;
-            }
-            Ok(_) => synced.refused.push((pair, reason)),
-            Err(f) => {
-                // Counted under the reason of this, the better informed, attempt.
-                uncount(&mut synced.match_rejections.0, reason.key());
-                synced.match_rejections.add(f.reason);
-                synced.refused.push((pair, f.reason));
-            }
-        }
-    }
-    if recovered {
-        synced.samples.sort_by(|a, b| {
-            a.pair
-                .t0
-                .total_cmp(&b.pair.t0)
-                .then(a.pair.t1.total_cmp(&b.pair.t1))
-        });
-    }
-}
-
-/// One fewer under `key` (never below zero).
-fn uncount(counts: &mut std::collections::BTreeMap<&'static str, usize>, key: &'static str) {
-    if let Some(n) = counts.get_mut(key) {
-        *n = n.saturating_sub(1);
     }
 }
 

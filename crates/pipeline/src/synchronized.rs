@@ -2,10 +2,10 @@
 //! ready for the solver and what was thrown away), read by the health checks and the
 //! clock-offset search.
 
-use crate::rejection::{Rejection, RejectionCounts};
+use crate::rejection::RejectionCounts;
 use crate::samples::PairSample;
 use crate::self_check::MatchSelfCheck;
-use crate::sync::{DiscardCounts, ScanPair, SyncLimits};
+use crate::sync::{DiscardCounts, SyncLimits};
 
 /// Samples ready for the solver, and what was thrown away.
 #[derive(Debug, Clone)]
@@ -24,10 +24,6 @@ pub struct Synchronized {
     pub discarded: DiscardCounts,
     /// The pairs counted in `discarded` as `match_failed`, by the matcher's reason.
     pub match_rejections: RejectionCounts,
-    /// Those pairs themselves, with their reason: a second matching pass tries them
-    /// again from the refined first guesses (and sweep compensation). Empty in the
-    /// joint summary of several logs.
-    pub refused: Vec<(ScanPair, Rejection)>,
     /// The matcher's own error per pair, from the closure of scan triples (see
     /// [`crate::self_check`]); `None` when too few triples close.
     pub match_self_check: Option<MatchSelfCheck>,
