@@ -181,8 +181,8 @@ mod tests {
     use crate::IcpParams;
 
     /// A wall at y = 2 m seen by 181 rays over 90°, with the readings `gap` missing
-    /// (0: no return), or replaced by `jump` (m: a far surface); the last 20 rays got
-    /// no return either (a sparse scan: missing returns are common).
+    /// (0: no return), or replaced by `jump` (m: a far surface); the first 40 and the
+    /// last 50 rays got no return either (a sparse scan: missing returns are common).
     fn wall_with_gap(gap: std::ops::Range<usize>, jump: Option<f32>) -> PreparedScan {
         let angles: Vec<f64> = (0..181)
             .map(|i| (45.0 + i as f64 * 0.5).to_radians())
@@ -191,7 +191,7 @@ mod tests {
             .iter()
             .enumerate()
             .map(|(i, a)| match (gap.contains(&i), jump) {
-                _ if i > 160 => 0.0,
+                _ if !(40..=130).contains(&i) => 0.0,
                 (false, _) => (2.0 / a.sin()) as f32,
                 (true, None) => 0.0,
                 (true, Some(far)) => far,
