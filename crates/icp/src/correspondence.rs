@@ -5,8 +5,11 @@
 //! the reference scan: first its closest valid reference point `j`, then the usable
 //! segment `(j, j+1)` or `(j−1, j)` on whose side `p` projects. There is no match when
 //! the closest point is farther than the gate, or when `p` projects beyond the end of
-//! a run (past a range discontinuity, i.e. towards an occluded or unseen part), or
-//! when neither segment has a usable local line.
+//! a run past a range discontinuity (towards an occluded or unseen part), or when
+//! neither segment has a usable local line. A run that ends because the next ray got
+//! no return (dark or glancing surfaces: half the readings of a real URG-04LX) is
+//! followed a little further: up to [`END_EXTENSION_SEGMENTS`] lengths of its end
+//! segment past its end, `p` is measured against the end segment's local line.
 //!
 //! The closest point is found either by the angular walk of CSM (rays are ordered by
 //! bearing: start at the ray pointing closest to `p`, walk outwards, and stop as soon
@@ -133,13 +136,129 @@ pub(crate) fn segment_for(reference: &PreparedScan, p: [f64; 2], j: usize) -> Op
         Some(j)
     } else if backward >= 0.0 {
         Some(j - 1)
+    } else if forward.is_nan() && backward < 0.0 && no_return_after(reference, j) {
+        within_extension(reference, j, j - 1, -backward).then(|| j - 1)
+    } else if backward.is_nan() && forward < 0.0 && no_return_before(reference, j) {
+        within_extension(reference, j, j + 1, -forward).then_some(j)
     } else {
         None
     }
 }
 
+/// Run ends where the surface may go on unseen: the next ray got no return.
+fn no_return_after(reference: &PreparedScan, j: usize) -> bool {
+    reference.no_return.get(j + 1).copied().unwrap_or(false)
+}
+
+/// … or the previous ray got no return (a reading beyond the maximum range is a far
+/// surface: the run's surface ended there).
+fn no_return_before(reference: &PreparedScan, j: usize) -> bool {
+    j > 0 && reference.no_return[j - 1]
+}
+
+/// Beyond the end `j` of a run whose last segment goes to `inner`, a point projecting
+/// `beyond` (m) past `j` still belongs to the end segment's line when that is at most
+/// [`END_EXTENSION_SEGMENTS`] segment lengths.
+fn within_extension(reference: &PreparedScan, j: usize, inner: usize, beyond: f32) -> bool {
+    let d2 = dist2(reference.rays[j].point, reference.rays[inner].point);
+    let limit = END_EXTENSION_SEGMENTS * d2.sqrt();
+    f64::from(beyond) <= limit
+}
+
+/// How far (in lengths of the end segment) a run's local line is followed past the
+/// run's end when the next ray got no return.
+const END_EXTENSION_SEGMENTS: f64 = 3.0;
+
 fn dist2(a: [f64; 2], b: [f64; 2]) -> f64 {
     let dx = a[0] - b[0];
     let dy = a[1] - b[1];
     dx * dx + dy * dy
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::IcpParams;
+
+    /// A wall at y = 2 m seen by 181 rays over 90°, with the readings `gap` missing
+    /// (0: no return), or replaced by `jump` (m: a far surface); the first 40 and the
+    /// last 50 rays got no return either (a sparse scan: missing returns are common).
+    fn wall_with_gap(gap: std::ops::Range<usize>, jump: Option<f32>) -> PreparedScan {
+        let angles: Vec<f64> = (0..181)
+            .map(|i| (45.0 + i as f64 * 0.5).to_radians())
+            .collect();
+        let ranges: Vec<f32> = angles
+            .iter()
+            .enumerate()
+            .map(|(i, a)| match (gap.contains(&i), jump) {
+                _ if !(40..=130).contains(&i) => 0.0,
+                (false, _) => (2.0 / a.sin()) as f32,
+                (true, None) => 0.0,
+                (true, Some(far)) => far,
+            })
+            .collect();
+        PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).expect("scan")
+    }
+
+    /// The point on the wall at x, and the closest reference point to it.
+    fn on_wall(scan: &PreparedScan, x: f64) -> ([f64; 2], usize) {
+        let p = [x, 2.0];
+        let j = (0..scan.len())
+            .filter(|&i| scan.valid[i])
+            .min_by(|&a, &b| dist2(scan.points[a], p).total_cmp(&dist2(scan.points[b], p)))
+            .expect("a valid point");
+        (p, j)
+    }
+
+    #[test]
+    fn a_run_ending_at_readings_without_return_is_followed_a_little_further() {
+        // Rays 90..100 (x from 0 to −0.17 m) got no return; the run before them ends
+        // at ray 89 (x ≈ 0.017 m), with segments ≈ 17 mm long.
+        let scan = wall_with_gap(90..100, None);
+        let (end, end_ray) = on_wall(&scan, 0.0175);
+        assert_eq!(end_ray, 89, "{end:?}");
+        // One and a half segment lengths past the end: measured against the end
+        // segment's line (before: no correspondence).
+        let (p, j) = on_wall(&scan, -0.008);
+        assert_eq!(j, 89);
+        assert_eq!(segment_for(&scan, p, j), Some(88));
+        // Likewise past the start of the run after the gap (ray 100).
+        let (p, j) = on_wall(&scan, -0.16);
+        assert_eq!(j, 100);
+        assert_eq!(segment_for(&scan, p, j), Some(100));
+        // Far past the end (5 segment lengths): unseen, no correspondence.
+        let (p, j) = on_wall(&scan, -0.07);
+        assert_eq!(segment_for(&scan, p, j), None, "ray {j}");
+    }
+
+    #[test]
+    fn a_run_ending_at_a_rare_dropout_is_not_followed() {
+        // The same gap in a scan that has no other missing reading: a dropout.
+        let angles: Vec<f64> = (0..181)
+            .map(|i| (45.0 + i as f64 * 0.5).to_radians())
+            .collect();
+        let ranges: Vec<f32> = angles
+            .iter()
+            .enumerate()
+            .map(|(i, a)| if i == 90 { 0.0 } else { (2.0 / a.sin()) as f32 })
+            .collect();
+        let scan =
+            PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).expect("scan");
+        let (p, j) = on_wall(&scan, 0.008);
+        assert_eq!(j, 89);
+        assert_eq!(segment_for(&scan, p, j), None);
+    }
+
+    #[test]
+    fn a_run_ending_at_a_range_jump_is_not_followed() {
+        // The same wall, rays 90..100 seeing a far surface instead: an occlusion edge,
+        // whether the far readings are valid (3.5 m) or beyond the matcher's maximum
+        // reading (4.5 m, above IcpParams::max_reading).
+        for far in [3.5, 4.5] {
+            let scan = wall_with_gap(90..100, Some(far));
+            let (p, j) = on_wall(&scan, -0.008);
+            assert_eq!(j, 89, "{far}");
+            assert_eq!(segment_for(&scan, p, j), None, "{far}");
+        }
+    }
 }

@@ -10,7 +10,8 @@
 //! 2. `correspondence`: each current point ↔ the segment between its two closest
 //!    consecutive reference points (closest point by CSM's angular walk over the
 //!    ordered rays — the default — or a kiddo k-d tree; no segment across a range
-//!    discontinuity, none beyond the end of a run), measured against that segment's
+//!    discontinuity, none beyond the end of a run, except up to three segment lengths
+//!    past a run that ends at readings without a return), measured against that segment's
 //!    local line, weighted by the inverse variance range noise gives the distance at
 //!    the two incidence angles.
 //! 3. `trimming`: adaptive outlier threshold (robust σ from the median, the size of

@@ -2,6 +2,10 @@
 //! odometry guesses with given parameters (sweep compensated), and tallies the errors.
 //!
 //! `cargo run --release -p odocal-pipeline --example match_diagnosis -- LOG STRIDE OFFSET r_l r_r b l_x l_y l_theta`
+//!
+//! Environment: `NOISE` prints the scans' own range noise; `DUMP` every pair's guess
+//! and result or error; `RATIO`, `SHARE` and `MAXR` override
+//! `max_residual_to_noise`, `min_matched_share` and `max_reading`.
 
 use odocal_geom::Pose2;
 use odocal_icp::IcpParams;
@@ -96,6 +100,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     if let Ok(v) = std::env::var("SHARE") {
         icp.min_matched_share = v.parse()?;
+    }
+    if let Ok(v) = std::env::var("MAXR") {
+        icp.max_reading = v.parse()?;
     }
     let results = match_pairs(&store, &pairs, &guesses, &icp, || {});
     let mut tally: BTreeMap<String, usize> = BTreeMap::new();
