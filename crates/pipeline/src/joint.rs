@@ -188,7 +188,10 @@ pub fn calibrate_logs_with_lasers(
     if let Some(check) = &synced.match_self_check {
         let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
         odocal_solver::inflate_sigma(&mut calibration, factor);
-        if let Some(l) = lasers.as_mut().filter(|_| factor.is_finite() && factor > 1.0) {
+        if let Some(l) = lasers
+            .as_mut()
+            .filter(|_| factor.is_finite() && factor > 1.0)
+        {
             l.covariance
                 .iter_mut()
                 .flatten()
