@@ -69,6 +69,8 @@ fn receive_times_are_refused_naming_the_jitter_once_with_the_command_to_run() {
     assert!(!out.status.success(), "not refused: {err}");
     assert!(err.contains("because the laser timestamps jitter"), "{err}");
     assert!(err.contains("leave out --use-receive-time"), "{err}");
+    // Holding known parameters cannot repair the timing: no --fix/--prior advice.
+    assert!(!err.contains("--fix NAME=VALUE"), "{err}");
     // Named once (before: three times, the third as "not the cause").
     assert_eq!(err.matches("timestamps jitter by").count(), 1, "{err}");
     // The motion's own verdict only as what it would give.

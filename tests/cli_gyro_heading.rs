@@ -91,6 +91,8 @@ fn gyro_heading_odometry_is_refused_by_name_with_the_joint_states_command() {
     );
     assert!(stderr.contains("use_imu_heading false"), "{stderr}");
     assert!(stderr.contains("the bag has IMU data (/imu)"), "{stderr}");
+    // Holding known parameters cannot repair a gyro heading: no --fix/--prior advice.
+    assert!(!stderr.contains("--fix NAME=VALUE"), "{stderr}");
     assert!(
         stderr.contains(&format!(
             "odocal calibrate {GYRO} --nominal {NOMINAL} --joint-states-topic /joint_states"

@@ -32,13 +32,12 @@ pub enum PipelineError {
     /// The solver returned numbers, but some parameters are so poorly determined
     /// (verdict "weak" or "not excited") that they would mislead.
     #[error(
-        "the data do not determine {} well enough{}: {sentence}{}{} (if some of them are \
-         known, hold them with --fix NAME=VALUE or give a prior with --prior \
-         NAME=VALUE±SIGMA, SI units; pass --accept-weak to see the numbers anyway){}",
+        "the data do not determine {} well enough{}: {sentence}{}{} ({}){}",
         parameters.join(", "),
         because(&diagnosis.causes),
         holds_sentence(&diagnosis.holds),
         caveat_sentence(&diagnosis.caveat),
+        way_out(diagnosis.no_hold),
         also_found(&diagnosis.faults)
     )]
     NotDetermined {
@@ -141,6 +140,17 @@ fn because(causes: &[String]) -> String {
         String::new()
     } else {
         format!(" because {}", causes.join(", and "))
+    }
+}
+
+/// The generic way out of a refusal for poorly determined parameters: hold the known
+/// ones (unless holding cannot help), or see the numbers anyway.
+fn way_out(no_hold: bool) -> &'static str {
+    if no_hold {
+        "pass --accept-weak to see the numbers anyway, all weak"
+    } else {
+        "if some of them are known, hold them with --fix NAME=VALUE or give a prior with \
+         --prior NAME=VALUE±SIGMA, SI units; pass --accept-weak to see the numbers anyway"
     }
 }
 

@@ -29,6 +29,10 @@ pub struct Diagnosis {
     /// Data faults found that are not the cause (set by
     /// [`PipelineError::with_faults`](crate::PipelineError::with_faults)).
     pub faults: Option<String>,
+    /// Holding known parameters would not help: the cause is in the data (timing,
+    /// a heading not from the wheels, scan matching), not in the motion, so the
+    /// refusal does not suggest `--fix` or `--prior`.
+    pub no_hold: bool,
 }
 
 /// A parameter to hold with `--fix`, with the value to hold it at when one is known.

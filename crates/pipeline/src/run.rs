@@ -489,6 +489,7 @@ pub(crate) fn refuse_poorly_determined(
                 },
                 caveat: None,
                 faults: None,
+                no_hold: unjudgeable.is_some() || !demoted.is_empty(),
             }),
         });
     }
