@@ -142,12 +142,24 @@ fn filter_of(choice: &TopicChoice) -> DecodeFilter {
 pub fn read_bag(path: &Path, opts: &BagOptions) -> Result<BagLog, BagError> {
     let name = path.display().to_string();
     let (format, collected) = scan_bag(path, filter_of(&opts.choice))?;
-    let selection = select::select(&name, &collected, &opts.choice)?;
-    let log = to_log::build_log(&name, &collected, &selection, opts.clock, &opts.read)?;
+    bag_log(&name, format, &collected, &opts.choice, opts)
+}
+
+/// The log of `collected` for the topics `choice` selects: the topic choice, then
+/// the log, with the scan topic's nominal pose.
+fn bag_log(
+    name: &str,
+    format: BagFormat,
+    collected: &Collected,
+    choice: &TopicChoice,
+    opts: &BagOptions,
+) -> Result<BagLog, BagError> {
+    let selection = select::select(name, collected, choice)?;
+    let log = to_log::build_log(name, collected, &selection, opts.clock, &opts.read)?;
     Ok(BagLog {
         format,
         log,
-        nominal_laser: nominal_laser(&collected, &selection.scan_topic),
+        nominal_laser: nominal_laser(collected, &selection.scan_topic),
         selection,
         topics: collected.topics.clone(),
         bytes_read: collected.bytes_read,
@@ -176,16 +188,7 @@ pub fn read_bag_lasers(
                 scan_topic: Some(topic.clone()),
                 ..choice.clone()
             };
-            let selection = select::select(&name, &collected, &choice)?;
-            let log = to_log::build_log(&name, &collected, &selection, opts.clock, &opts.read)?;
-            Ok(BagLog {
-                format,
-                log,
-                nominal_laser: nominal_laser(&collected, &selection.scan_topic),
-                selection,
-                topics: collected.topics.clone(),
-                bytes_read: collected.bytes_read,
-            })
+            bag_log(&name, format, &collected, &choice, opts)
         })
         .collect()
 }

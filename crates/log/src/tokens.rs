@@ -30,15 +30,8 @@ impl<'a> Tokens<'a> {
     #[inline]
     pub(crate) fn next_decimal(&mut self) -> Option<(&'a [u8], Option<DecimalSplit>)> {
         let s = self.s;
-        let mut i = self.i;
-        while i < s.len() && is_separator(s[i]) {
-            i += 1;
-        }
-        if i == s.len() {
-            self.i = i;
-            return None;
-        }
-        let start = i;
+        let start = self.skip_separators()?;
+        let mut i = start;
         let neg = s[i] == b'-';
         if neg || s[i] == b'+' {
             i += 1;
@@ -68,6 +61,16 @@ impl<'a> Tokens<'a> {
         Some((&s[start..i], split))
     }
 
+    /// Moves past separators to the start of the next token and returns it; `None`
+    /// (at the end) when only separators are left.
+    #[inline]
+    fn skip_separators(&mut self) -> Option<usize> {
+        while self.i < self.s.len() && is_separator(self.s[self.i]) {
+            self.i += 1;
+        }
+        (self.i < self.s.len()).then_some(self.i)
+    }
+
     /// How many tokens are left (used only to explain an error).
     pub(crate) fn count_remaining(&self) -> usize {
         self.clone().count()
@@ -80,15 +83,8 @@ impl<'a> Iterator for Tokens<'a> {
     #[inline]
     fn next(&mut self) -> Option<&'a [u8]> {
         let s = self.s;
-        let mut i = self.i;
-        while i < s.len() && is_separator(s[i]) {
-            i += 1;
-        }
-        if i == s.len() {
-            self.i = i;
-            return None;
-        }
-        let start = i;
+        let start = self.skip_separators()?;
+        let mut i = start;
         while i < s.len() && !is_separator(s[i]) {
             i += 1;
         }
