@@ -259,7 +259,13 @@ pub fn calibrate_logs_with_lasers(
         solve: a.solve + o.timing.solve,
     });
     timing.solve += t.elapsed().as_secs_f64();
+    // One laser's range scale for the six parameters: the first log's (several
+    // lasers' own scales are not composed; docs/several-lasers.md).
+    let range_scale = outcomes
+        .first()
+        .map_or_else(crate::RangeScale::unknown, |o| o.range_scale.clone());
     let joint = Outcome {
+        range_scale,
         health,
         synced,
         calibration,

@@ -24,7 +24,9 @@
 //! whole, with timing), [`joint`] (several logs of one robot, one calibration), [`lasers`]
 //! (several lasers on it: the wheels shared, one ℓ per laser) and
 //! [`log_agreement`] (each of them against the joint estimate), [`samples`] (the samples and their tuples), [`estimate`] (the
-//! core numbers of a result).
+//! core numbers of a result), [`range_finder`] (common range finders recognised from
+//! their scans) and [`range_scale`] (the laser's range-scale σ that every calibrated
+//! distance carries).
 
 #![deny(missing_docs)]
 
@@ -44,6 +46,8 @@ pub mod matching;
 pub mod options;
 pub mod parallel;
 mod progress;
+pub mod range_finder;
+pub mod range_scale;
 pub mod refusal;
 pub mod rejection;
 pub mod run;
@@ -67,6 +71,8 @@ pub use lasers::laser_indices;
 pub use odocal_solver::Trim;
 pub use options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 pub use progress::{NoProgress, Progress};
+pub use range_finder::{recognise, LaserSignature, RangeFinder, RANGE_FINDERS};
+pub use range_scale::{RangeScale, RangeScaleSource};
 pub use rejection::{MatchFailure, Rejection, RejectionCounts};
 pub use run::{calibrate_log, synchronize_and_match, Outcome, Timing};
 pub use samples::write_tuples;

@@ -58,9 +58,23 @@ pub struct Options {
     /// `initial_params` (the nominal parameters), so the odometry's heading is checked
     /// to come from the wheels (see [`crate::health::gyro_heading`]).
     pub odometry_only: bool,
+    /// One σ of the laser's range scale, relative (0.01: 1 %), as stated by the user;
+    /// `None`: the data sheet's of the range finder recognised in the log (see
+    /// [`crate::range_finder`]), or none when it is not recognised.
+    pub laser_range_scale: Option<f64>,
+    /// The scans' frame (a bag's `header.frame_id`), when the input tells it: one more
+    /// clue to recognise the range finder by.
+    pub laser_frame: Option<String>,
 }
 
 impl Options {
+    /// The range-scale σ of a run on `log`: [`Options::laser_range_scale`] when
+    /// stated, else the data sheet's of the range finder recognised in it.
+    pub fn range_scale(&self, log: &odocal_log::Log) -> crate::RangeScale {
+        let signature = crate::LaserSignature::of_log(log, self.laser_frame.as_deref());
+        crate::RangeScale::resolve(self.laser_range_scale, signature.as_ref())
+    }
+
     /// The solver's settings with [`Options::accept_weak`] passed on.
     pub fn solve_options(&self) -> SolveOptions {
         SolveOptions {
@@ -88,6 +102,8 @@ impl Default for Options {
             icp: IcpParams::default(),
             accept_weak: false,
             odometry_only: false,
+            laser_range_scale: None,
+            laser_frame: None,
         }
     }
 }

@@ -57,6 +57,10 @@ pub struct Outcome {
     pub timing: Timing,
     /// The two halves of the samples calibrated separately and compared.
     pub consistency: Consistency,
+    /// The laser's range-scale σ that the distances carry (stated, or from the data
+    /// sheet of the range finder recognised in the log); the calibration's covariance
+    /// is the data's alone, [`crate::Estimate`] gives both.
+    pub range_scale: crate::RangeScale,
 }
 
 /// Ticks per revolution from the options or the log, checking the log has what
@@ -632,6 +636,7 @@ pub fn calibrate_log(
         offset,
         timing,
         consistency,
+        range_scale: opts.range_scale(log),
     })
 }
 

@@ -14,7 +14,9 @@
 //! 3. [`trimming`]: outlier removal, ICRA or T-RO rule, re-solving each round;
 //! 4. [`refine`]: maximum-likelihood refinement (Levenberg–Marquardt on `ŝ_pred − ŝ`);
 //! 5. covariance (inverse Fisher information with analytic Jacobians) and an
-//!    [`Observability`] report; degenerate data give [`SolveError::NotExcited`].
+//!    [`Observability`] report; degenerate data give [`SolveError::NotExcited`];
+//!    the laser's range scale, which the data cannot tell, is added to it by
+//!    [`with_range_scale`].
 //!
 //! Entry point: [`calibrate`]; for a robot with several lasers (wheels shared, one ℓ
 //! per laser), [`calibrate_lasers`].
@@ -57,6 +59,7 @@ mod observability;
 mod packed;
 mod params;
 mod partial;
+mod range_scale;
 pub mod refine;
 mod sample;
 mod shared_scans;
@@ -82,6 +85,7 @@ pub use observability::{
     PARTIAL_CALIBRATION_HINT,
 };
 pub use params::{Params, PARAMETER_NAMES};
+pub use range_scale::{range_scale_covariance, range_scale_direction, with_range_scale};
 pub use refine::Refinement;
 pub use sample::{ProfileSegment, Sample};
 pub use shared_scans::{SharedScanNoise, MIN_SHARED_SCANS};
