@@ -90,6 +90,18 @@ pub struct Args {
     pub second_pass: bool,
     #[command(flatten)]
     pub partial: PartialArgs,
+    /// The laser's range-scale uncertainty in per cent (one σ): every calibrated
+    /// distance (r_L, r_R, b, ℓx, ℓy) scales with the laser's ranges, and the data
+    /// cannot tell that scale. Default: the data sheet's range accuracy of the range
+    /// finder recognised from the scans (URG-04LX 1 %, RPLIDAR A1 1 %, LDS-01 5 %, …),
+    /// none when it is not recognised. 0: the ranges' scale is known exact.
+    #[arg(
+        long,
+        value_name = "PCT",
+        value_parser = range_scale_percent,
+        allow_negative_numbers = true
+    )]
+    pub laser_range_scale: Option<f64>,
     /// Give log N (its position among the LOGs, from 1) a laser of its own: its own ℓ,
     /// the wheels shared with the other logs (a laser re-mounted between recordings, or
     /// another laser of the robot logged separately). Repeatable; logs not named share
@@ -134,6 +146,18 @@ fn positive_seconds(text: &str) -> Result<f64, String> {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         _ => Err(format!(
             "expected a positive number of seconds, got '{text}'"
+        )),
+    }
+}
+
+/// A range-scale uncertainty in per cent (`--laser-range-scale`), as a fraction: a
+/// finite number from 0 to 50.
+fn range_scale_percent(text: &str) -> Result<f64, String> {
+    match text.trim().trim_end_matches('%').parse::<f64>() {
+        Ok(v) if v.is_finite() && (0.0..=50.0).contains(&v) => Ok(v / 100.0),
+        _ => Err(format!(
+            "expected the laser's range-scale uncertainty in per cent, from 0 to 50 \
+             (e.g. 1 for a data sheet's ±1 % of the range), got '{text}'"
         )),
     }
 }
@@ -214,6 +238,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         bootstrap_guesses: !args.identity_guess,
         accept_weak: args.partial.accept_weak,
         odometry_only: odometry_only.is_some(),
+        laser_range_scale: args.laser_range_scale,
+        laser_frame: laser.as_ref().map(|l| l.laser_frame.clone()),
         ..Options::default()
     };
     opts.solve.trim = args.trim.into();

@@ -72,8 +72,8 @@ impl LaserSignature {
             self.rays,
             self.spacing.to_degrees(),
             self.coverage.to_degrees(),
-            self.min_range,
-            self.max_range
+            metres(self.min_range),
+            metres(self.max_range)
         );
         if self.laser_type == 2 {
             s.push_str(", Carmen laser type 2 (Hokuyo URG)");
@@ -83,6 +83,13 @@ impl LaserSignature {
         }
         s
     }
+}
+
+/// A range in metres to the millimetre, without trailing zeros (a bag's `f32`
+/// 0.12 reads 0.11999999731779099 as `f64`).
+fn metres(x: f64) -> String {
+    let s = format!("{x:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// One range finder of the table: its name, what identifies it, and its data sheet's

@@ -16,8 +16,9 @@ use serde_json::Value;
 const CSS: &str = include_str!("report.css");
 
 /// Top-level results.json keys shown in a section of their own.
-const SHOWN: [&str; 18] = [
+const SHOWN: [&str; 19] = [
     "log",
+    "range_scale",
     "logs",
     "lasers",
     "r_l",
@@ -170,10 +171,13 @@ fn parameters(r: &Report, v: &Value) -> Markup {
     let has_constraints = v["settings"]["constraints"]
         .as_array()
         .is_some_and(|a| a.iter().any(|c| c.as_str() != Some("free")));
+    let has_scale = r.range_scale.scale.applies();
     html! {
         table.params {
             tr {
-                th { "parameter" } th { "estimate" } th { "σ" } th { "unit" } th { "verdict" }
+                th { "parameter" } th { "estimate" } th { @if has_scale { "σ (data)" } @else { "σ" } }
+                @if has_scale { th { "σ (" (r.range_scale.scale.label()) ")" } th { "σ together" } }
+                th { "unit" } th { "verdict" }
                 @if r.nominal.is_some() { th { "nominal" } th { "correction" } }
                 @if has_constraints { th { "given" } }
             }
@@ -185,6 +189,10 @@ fn parameters(r: &Report, v: &Value) -> Markup {
                     th { (PARAMETER_LABELS[i]) }
                     td { (num(&format!("/{}", KEYS[i]), values[i], scale, digits)) }
                     td { "± " (num(&format!("/sigma/{i}"), r.sigma[i], scale, digits)) }
+                    @if has_scale {
+                        td { "± " (num(&format!("/range_scale/sigma_from_scale/{i}"), r.range_scale.sigma_from_scale[i], scale, digits)) }
+                        td { "± " (num(&format!("/range_scale/sigma_total/{i}"), r.range_scale.sigma_total[i], scale, digits)) }
+                    }
                     td { (unit) }
                     td { span class=(format!("verdict {}", verdict.split(" (").next().unwrap_or("").replace(' ', "-"))) { (verdict) } }
                     @if let Some(n) = r.nominal {
@@ -204,6 +212,7 @@ fn parameters(r: &Report, v: &Value) -> Markup {
                         Some(sd) => { "± " (num("/time_offset_sigma_s", sd, 1e3, 2)) },
                         None => "—",
                     } }
+                    @if has_scale { td { "—" } td { "—" } }
                     td { "ms" }
                     td { "estimated" }
                     @if r.nominal.is_some() { td { "—" } td { "—" } }
@@ -211,6 +220,7 @@ fn parameters(r: &Report, v: &Value) -> Markup {
                 }
             }
         }
+        p.note #range-scale { "Laser range scale: " (r.range_scale.statement) "." }
         @if r.odometry_only {
             p.warning #odometry-only {
                 "Odometry-only mode: the input has odometry poses, no wheel encoders; the wheel rotations were recovered from the poses with the nominal r_L, r_R and b (--nominal). The absolute radii and wheel distance are only as good as those nominal values; the correction factors (estimate / nominal) are what the data determine."

@@ -1,6 +1,6 @@
 //! The report of a calibration: the human summary and `results.json` ([`report`]),
 //! the joint report of several logs ([`joint`]), where the run came from
-//! ([`provenance`]), the figures ([`figures`], drawn with `plotters`), the one-page
+//! ([`provenance`]), the laser's range scale in σ ([`range_scale`]), the figures ([`figures`], drawn with `plotters`), the one-page
 //! `results.html` ([`html`]), the results in ROS terms ([`export`]) and the files
 //! `--out DIR` writes ([`output`]).
 //!
@@ -24,6 +24,7 @@ pub mod html;
 pub mod joint;
 pub mod output;
 pub mod provenance;
+pub mod range_scale;
 pub mod report;
 
 pub use export::{
@@ -33,4 +34,5 @@ pub use joint::{build_joint_report, laser_rows, Between, LaserRow, LogRow};
 pub use odocal_pipeline::{Finding, FindingKind, Severity};
 pub use output::{html_report, is_output_name, write_html, write_outputs};
 pub use provenance::{sha256_of_input, Provenance};
+pub use range_scale::RangeScaleReport;
 pub use report::{build_report, NominalLaserPose, Report};

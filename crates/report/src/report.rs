@@ -25,10 +25,15 @@ pub struct Report {
     /// The estimate: fields `r_l`, `r_r`, `b`, `l_x`, `l_y`, `l_theta` (m, rad).
     #[serde(flatten)]
     pub params: FlatParams,
-    /// Standard deviations, order r_L, r_R, b, ℓx, ℓy, ℓθ.
+    /// Standard deviations from the data alone, order r_L, r_R, b, ℓx, ℓy, ℓθ (the
+    /// laser's range scale is in `range_scale`, with data and scale together).
     pub sigma: [f64; 6],
-    /// Covariance 6×6, order r_L, r_R, b, ℓx, ℓy, ℓθ.
+    /// Covariance 6×6 from the data alone, order r_L, r_R, b, ℓx, ℓy, ℓθ.
     pub covariance: [[f64; 6]; 6],
+    /// The laser's range scale: its σ and where it came from (stated, the data sheet
+    /// of the range finder recognised, unknown), the σ it adds, and the σ and
+    /// covariance of data and scale together.
+    pub range_scale: crate::range_scale::RangeScaleReport,
     /// `J = [[r_L/2, r_R/2], [−r_L/b, r_R/b]]`.
     pub j: [[f64; 2]; 2],
     /// The closed-form estimate (before refinement): r_L, r_R, b, ℓx, ℓy, ℓθ.
@@ -211,6 +216,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         params: FlatParams::from_array(v),
         sigma: e.sigma,
         covariance: e.covariance,
+        range_scale: crate::range_scale::RangeScaleReport::new(&outcome.range_scale, &e),
         j: e.j,
         closed_form: c.closed_form.to_vector(),
         samples_used: e.samples_used,
@@ -326,10 +332,10 @@ impl fmt::Display for Report {
             } else {
                 writeln!(
                     f,
-                    "  {:<8} = {:>+12.4} mm  ± {:.4} mm  {}",
+                    "  {:<8} = {:>+12.4} mm  {}  {}",
                     PARAMETER_NAMES[i],
                     v[i] * 1e3,
-                    self.sigma[i] * 1e3,
+                    self.range_scale.sigma_words(i, self.sigma[i], 1e3, "mm"),
                     verdict
                 )?;
             }
@@ -420,6 +426,7 @@ impl fmt::Display for Report {
         if let Some(w) = &o.wheel_signs {
             writeln!(f, "  warning: {w}")?;
         }
+        writeln!(f, "  laser range scale: {}", self.range_scale.statement)?;
         if let Some(t) = self.sweep_compensated_s {
             writeln!(
                 f,

@@ -1,0 +1,126 @@
+//! `--laser-range-scale` and the range finders recognised from the scans (issue 20
+//! item 5): the scale's σ is reported beside the data's, `sigma`/`covariance` keep
+//! meaning the data's alone, and an unrecognised laser is named as such with the
+//! option to state its scale.
+
+mod common;
+
+use common::{cleanup, odocal, simulated_log, stderr};
+use serde_json::Value;
+
+/// `odocal calibrate ARGS --json`, parsed; panics with stderr when it fails.
+fn calibrate_json(args: &[&str]) -> Value {
+    let mut all = vec!["calibrate"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    let o = odocal(&all);
+    assert!(o.status.success(), "{}", stderr(&o));
+    serde_json::from_slice(&o.stdout).expect("one JSON object")
+}
+
+fn array(v: &Value, key: &str) -> Vec<f64> {
+    v.pointer(key)
+        .and_then(Value::as_array)
+        .unwrap_or_else(|| panic!("{key} missing"))
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect()
+}
+
+#[test]
+fn urg_04lx_is_recognised_and_its_scale_reported_beside_the_data_sigma() {
+    let v = calibrate_json(&["fixtures/demo.log"]);
+    assert_eq!(v["range_scale"]["sensor"], "Hokuyo URG-04LX");
+    assert_eq!(v["range_scale"]["source"], "data_sheet");
+    assert_eq!(v["range_scale"]["sigma"], 0.01);
+    assert!(v["range_scale"]["recognised_from"]
+        .as_str()
+        .unwrap()
+        .starts_with("681 rays 0.352° apart"));
+    let params: Vec<f64> = ["r_l", "r_r", "b", "l_x", "l_y", "l_theta"]
+        .iter()
+        .map(|k| v[k].as_f64().unwrap())
+        .collect();
+    let data = array(&v, "/sigma");
+    let scale = array(&v, "/range_scale/sigma_from_scale");
+    let total = array(&v, "/range_scale/sigma_total");
+    for i in 0..5 {
+        assert!((scale[i] - 0.01 * params[i].abs()).abs() < 1e-12, "{i}");
+        let want = data[i].hypot(scale[i]);
+        assert!(
+            (total[i] - want).abs() < 1e-9 * want,
+            "{i}: {} vs {want}",
+            total[i]
+        );
+    }
+    assert_eq!(scale[5], 0.0);
+    assert_eq!(total[5], data[5]);
+
+    // A stated scale replaces the sheet's; the data's σ do not move.
+    let stated = calibrate_json(&["fixtures/demo.log", "--laser-range-scale", "0.5"]);
+    assert_eq!(stated["range_scale"]["source"], "stated");
+    assert_eq!(stated["range_scale"]["sigma"], 0.005);
+    assert_eq!(array(&stated, "/sigma"), data);
+    let exact = calibrate_json(&["fixtures/demo.log", "--laser-range-scale", "0"]);
+    assert_eq!(array(&exact, "/range_scale/sigma_total"), data);
+
+    // The summary: the data's σ, the scale's, together; what does not depend on it.
+    let o = odocal(&["calibrate", "fixtures/demo.log"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("(data) ±") && text.contains("(laser range scale 1 %) = ±"),
+        "{text}"
+    );
+    assert!(
+        text.contains("laser recognised as a Hokuyo URG-04LX"),
+        "{text}"
+    );
+    assert!(
+        text.contains("(J21, J22) and l_theta do not depend on it"),
+        "{text}"
+    );
+}
+
+#[test]
+fn lds_of_a_bag_is_recognised() {
+    let v = calibrate_json(&["fixtures/bags/turtlebot_lds.bag"]);
+    assert_eq!(v["range_scale"]["sensor"], "ROBOTIS LDS-01 (HLS-LFCD2)");
+    assert_eq!(v["range_scale"]["sigma"], 0.05);
+    let total = array(&v, "/range_scale/sigma_total");
+    assert!(total[0] > 0.04 * v["r_l"].as_f64().unwrap());
+}
+
+#[test]
+fn an_unrecognised_laser_says_the_distances_assume_an_exact_scale() {
+    // URG spacing with a 30 m range: no range finder of the table.
+    let (path, _) = simulated_log("range-scale-unknown", "khepera", 30.0, 3, |c| {
+        c.laser.max_range = 30.0;
+    });
+    let p = path.to_str().unwrap();
+    let v = calibrate_json(&[p]);
+    assert_eq!(v["range_scale"]["source"], "unknown");
+    assert!(v["range_scale"].get("sensor").is_none());
+    assert_eq!(array(&v, "/range_scale/sigma_total"), array(&v, "/sigma"));
+    let o = odocal(&["calibrate", p]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("laser not recognised")
+            && text.contains("assume an exact laser range scale")
+            && text.contains("--laser-range-scale 1"),
+        "{text}"
+    );
+    cleanup(&path);
+}
+
+#[test]
+fn a_bad_scale_is_refused_with_what_is_expected() {
+    for bad in ["-1", "80", "abc", "NaN"] {
+        let o = odocal(&["calibrate", "fixtures/demo.log", "--laser-range-scale", bad]);
+        assert!(!o.status.success(), "{bad}");
+        let e = stderr(&o);
+        assert!(
+            e.contains("range-scale uncertainty in per cent"),
+            "{bad}: {e}"
+        );
+    }
+}
