@@ -124,3 +124,28 @@ fn a_bad_scale_is_refused_with_what_is_expected() {
         );
     }
 }
+
+#[test]
+fn each_laser_of_a_bag_with_two_is_recognised_on_its_own() {
+    let v = calibrate_json(&[
+        "fixtures/bags/turtlebot_two_lidars.bag",
+        "--scan-topic",
+        "/scan_front",
+        "--scan-topic",
+        "/scan_rear",
+    ]);
+    let lasers = v["lasers"].as_array().expect("a row per laser");
+    assert_eq!(
+        lasers[0]["range_scale"]["sensor"],
+        "ROBOTIS LDS-01 (HLS-LFCD2)"
+    );
+    assert_eq!(lasers[1]["range_scale"]["sensor"], "SICK LMS2xx");
+    // The front LDS's ℓx carries its 5 %; the rear SICK's σ are the data's.
+    let front_x = lasers[0]["l_x"].as_f64().unwrap();
+    let want = lasers[0]["sigma"][0]
+        .as_f64()
+        .unwrap()
+        .hypot(0.05 * front_x);
+    assert!((lasers[0]["sigma_total"][0].as_f64().unwrap() - want).abs() < 1e-12);
+    assert_eq!(lasers[1]["sigma_total"], lasers[1]["sigma"]);
+}

@@ -239,7 +239,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         accept_weak: args.partial.accept_weak,
         odometry_only: odometry_only.is_some(),
         laser_range_scale: args.laser_range_scale,
-        laser_frame: laser.as_ref().map(|l| l.laser_frame.clone()),
+        // The frame of the one laser read (several lasers' frames differ).
+        laser_frame: laser
+            .as_ref()
+            .filter(|_| logs.len() == 1)
+            .map(|l| l.laser_frame.clone()),
         ..Options::default()
     };
     opts.solve.trim = args.trim.into();

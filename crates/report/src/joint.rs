@@ -66,6 +66,11 @@ pub struct LaserRow {
     pub samples: usize,
     /// Of them, the samples the joint estimate used.
     pub samples_used: usize,
+    /// The laser's range scale (stated, or its recognised range finder's data sheet),
+    /// from its first log: its ℓx, ℓy scale with it.
+    pub range_scale: odocal_pipeline::RangeScale,
+    /// σ of (ℓx, ℓy, ℓθ) with the laser's range scale: `hypot(σ, σ_s·ℓ)` for ℓx, ℓy.
+    pub sigma_total: [f64; 3],
     /// The laser's pose in the first laser's frame, `ℓ₁⁻¹ ⊕ ℓ_k`, with its covariance
     /// (from the joint covariance of ℓ₁ and ℓ_k, cross terms included); identity with
     /// zero covariance for the first laser.
@@ -123,7 +128,18 @@ pub fn laser_rows(
                 std::array::from_fn(|i| std::array::from_fn(|j| c6[3 + i][3 + j]));
             let (t, tc) = lasers.from_first(k);
             let sigma = |c: &[[f64; 3]; 3]| std::array::from_fn(|i| c[i][i].max(0.0).sqrt());
+            let range_scale = mine
+                .first()
+                .and_then(|&i| joint.logs.get(i))
+                .map_or_else(odocal_pipeline::RangeScale::unknown, |o| {
+                    o.range_scale.clone()
+                });
+            let data: [f64; 3] = sigma(&covariance);
+            let s = range_scale.sigma;
+            let sigma_total = [data[0].hypot(s * p.x), data[1].hypot(s * p.y), data[2]];
             LaserRow {
+                range_scale,
+                sigma_total,
                 topic: mine.iter().find_map(|&i| topics.get(i).cloned().flatten()),
                 logs: mine.iter().filter_map(|&i| names.get(i).cloned()).collect(),
                 l_x: p.x,
@@ -183,6 +199,19 @@ pub(crate) fn write_laser_table(f: &mut fmt::Formatter<'_>, rows: &[LaserRow]) -
                 b.theta.to_degrees(),
                 b.sigma[2].to_degrees()
             )?;
+        }
+        let scale = &r.range_scale;
+        match &scale.sensor {
+            Some(sensor) if scale.applies() => write!(
+                f,
+                "; {sensor}, {}: ℓx ± {:.2} mm, ℓy ± {:.2} mm with it",
+                scale.label(),
+                r.sigma_total[0] * 1e3,
+                r.sigma_total[1] * 1e3
+            )?,
+            Some(sensor) => write!(f, "; {sensor}, no range-scale figure")?,
+            None if scale.applies() => write!(f, "; {}", scale.label())?,
+            None => write!(f, "; laser not recognised")?,
         }
         writeln!(f)?;
     }
