@@ -149,3 +149,17 @@ fn each_laser_of_a_bag_with_two_is_recognised_on_its_own() {
     assert!((lasers[0]["sigma_total"][0].as_f64().unwrap() - want).abs() < 1e-12);
     assert_eq!(lasers[1]["sigma_total"], lasers[1]["sigma"]);
 }
+
+#[test]
+fn info_names_the_range_finder_calibrate_would_recognise() {
+    let o = odocal(&["info", "fixtures/bags/turtlebot_lds.bag", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["range_scale"]["sensor"], "ROBOTIS LDS-01 (HLS-LFCD2)");
+    let o = odocal(&["info", "fixtures/demo.log"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("laser range scale: laser recognised as a Hokuyo URG-04LX"),
+        "{text}"
+    );
+}

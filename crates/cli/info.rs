@@ -37,6 +37,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ..Options::default()
     };
     let (_, findings) = health::check_log(&log, &opts);
+    let range_scale = opts.range_scale(&log);
     if args.json {
         let mut value = serde_json::to_value(&summary).context("serializing the summary")?;
         if let Some(map) = value.as_object_mut() {
@@ -44,11 +45,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 "health".into(),
                 serde_json::to_value(&findings).context("serializing the findings")?,
             );
+            map.insert("range_scale".into(), serde_json::to_value(&range_scale)?);
         }
         let text = serde_json::to_string_pretty(&value).context("serializing the summary")?;
         write_json_stdout(&text)?;
     } else {
         out!("{summary}")?;
+        outln!("laser range scale: {}", range_scale.sentence())?;
         print_findings(&findings)?;
     }
     Ok(())
@@ -66,6 +69,14 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
         ),
         Err(e) => (Err(e.to_string()), None, Vec::new()),
     };
+    // The range finder `calibrate` would recognise in the chosen scans.
+    let range_scale = info.calibration.as_ref().ok().map(|(_, log)| {
+        Options {
+            laser_frame: info.nominal_laser.as_ref().map(|l| l.laser_frame.clone()),
+            ..Options::default()
+        }
+        .range_scale(log)
+    });
     if args.json {
         let mut obj = match &summary {
             Some(s) => serde_json::to_value(s)?,
@@ -102,6 +113,9 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
             o.insert("health".into(), serde_json::to_value(&findings)?);
             if let Some(l) = &info.nominal_laser {
                 o.insert("nominal_laser".into(), serde_json::to_value(l)?);
+            }
+            if let Some(r) = &range_scale {
+                o.insert("range_scale".into(), serde_json::to_value(r)?);
             }
         }
         write_json_stdout(&serde_json::to_string_pretty(&obj)?)?;
@@ -177,6 +191,9 @@ fn bag_info(args: &Args) -> anyhow::Result<()> {
     }
     if let Some(s) = summary {
         print_bag_summary(&s)?;
+    }
+    if let Some(r) = &range_scale {
+        outln!("laser range scale: {}", r.sentence())?;
     }
     print_findings(&findings)?;
     Ok(())
