@@ -112,7 +112,11 @@ impl RangeScale {
                  assume an exact laser range scale ({RANGE_SCALE_OPTION} PCT to state one)",
                 self.data_sheet.as_deref().unwrap_or("")
             ),
-            RangeScaleSource::Stated | RangeScaleSource::Unknown => format!(
+            RangeScaleSource::Stated => format!(
+                "{sensor}; range scale stated exact ({RANGE_SCALE_OPTION} 0): the distances \
+                 carry no scale term"
+            ),
+            RangeScaleSource::Unknown => format!(
                 "{sensor}; distances (r_L, r_R, b, l_x, l_y) assume an exact laser range scale: \
                  a laser reading 1 % long makes them 1 % large, and the data cannot tell; \
                  state the data sheet's range accuracy with {RANGE_SCALE_OPTION} PCT (e.g. \
@@ -145,6 +149,12 @@ mod tests {
         assert_eq!(stated.sigma, 0.002);
         assert_eq!(stated.source, RangeScaleSource::Stated);
         assert_eq!(stated.label(), "laser range scale 0.2 %");
+        let exact = RangeScale::resolve(Some(0.0), Some(&urg));
+        assert!(
+            exact.sentence().contains("stated exact"),
+            "{}",
+            exact.sentence()
+        );
         let none = RangeScale::resolve(None, None);
         assert!(!none.applies());
         assert!(none

@@ -357,7 +357,7 @@ pub fn page_with_results(report: &Report, results: &Value, figures: &[Figure]) -
                 section #parameters {
                     h2 { "Parameters" }
                     (parameters(r, v))
-                    p.note { "σ from the covariance of the estimate; verdicts from σ relative to the value (radii, b), to b (ℓx, ℓy), or in degrees (ℓθ)." }
+                    p.note { "σ from the covariance of the estimate (the data's; the laser range scale's, when known, in its own column and in σ together); verdicts from the data's σ relative to the value (radii, b), to b (ℓx, ℓy), or in degrees (ℓθ): how well the drive determines each parameter, the scale aside." }
                 }
                 @if let Some(logs) = v.get("logs") {
                     section #logs {
