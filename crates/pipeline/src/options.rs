@@ -58,6 +58,10 @@ pub struct Options {
     /// `initial_params` (the nominal parameters), so the odometry's heading is checked
     /// to come from the wheels (see [`crate::health::gyro_heading`]).
     pub odometry_only: bool,
+    /// The sideways slide of a skid-steer robot in turns: checked for and estimated
+    /// when found (default), always estimated, or neither (see
+    /// [`crate::lateral_slip`]).
+    pub lateral_slip: crate::lateral_slip::SlideModel,
 }
 
 impl Options {
@@ -88,6 +92,7 @@ impl Default for Options {
             icp: IcpParams::default(),
             accept_weak: false,
             odometry_only: false,
+            lateral_slip: Default::default(),
         }
     }
 }

@@ -14,7 +14,9 @@
 //! 3. [`trimming`]: outlier removal, ICRA or T-RO rule, re-solving each round;
 //! 4. [`refine`]: maximum-likelihood refinement (Levenberg–Marquardt on `ŝ_pred − ŝ`);
 //! 5. covariance (inverse Fisher information with analytic Jacobians) and an
-//!    [`Observability`] report; degenerate data give [`SolveError::NotExcited`].
+//!    [`Observability`] report; degenerate data give [`SolveError::NotExcited`];
+//! 6. optionally, for skid-steer robots, a seventh parameter: the sideways slide in
+//!    turns `v_y = −k·v·ω` ([`fit_lateral_slip`], [`LateralSlip`]).
 //!
 //! Entry point: [`calibrate`]; for a robot with several lasers (wheels shared, one ℓ
 //! per laser), [`calibrate_lasers`].
@@ -50,6 +52,7 @@ mod error;
 mod inflate;
 mod kinematics;
 mod lasers;
+mod lateral_slip;
 mod linalg;
 mod noise;
 mod normal_equations;
@@ -60,6 +63,7 @@ mod partial;
 pub mod refine;
 mod sample;
 mod shared_scans;
+mod slide_kinematics;
 pub mod step1;
 pub mod step2;
 pub mod trimming;
@@ -76,6 +80,7 @@ pub use error::SolveError;
 pub use inflate::inflate_sigma;
 pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
 pub use lasers::{calibrate_lasers, LasersCalibration};
+pub use lateral_slip::{fit_lateral_slip, LateralSlip, SlideFit};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
 pub use observability::{
     MotionContent, Observability, ParameterReport, Verdict, MOTION_CLASS_RATIO,
