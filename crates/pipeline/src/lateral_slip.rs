@@ -7,8 +7,10 @@
 //! faster slides more), the six parameters re-fitted with it. It fires when `k` is
 //! outward (`k > 0`, what a skid-steer robot's wheels do), significant (above
 //! [`SIGNIFICANCE`] σ) and matters (it moves ℓx by more than ℓx's own σ); then the
-//! estimate includes it and a finding says so. An inward `k` as significant is no
-//! slide a robot does: named, not used.
+//! estimate includes it and a finding says so. An outward `k` too uncertain to be
+//! sure of that would still move ℓx by more than its σ gets a note naming
+//! `--lateral-slip`; an inward `k` as significant is no slide a robot does: named,
+//! not used.
 
 use crate::finding::{Finding, FindingKind};
 use odocal_solver::{fit_lateral_slip, Calibration, LateralSlip, Sample, SolveOptions};
@@ -93,6 +95,19 @@ pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> 
             ),
         ));
     }
+    let sigma_l_x = calibration.covariance[3][3].max(0.0).sqrt();
+    if slip.k > 0.0 && slip.l_x_shift.abs() > sigma_l_x {
+        // Not significant, but it would matter: a skid-steer robot's user should
+        // know what the slide would do to ℓx.
+        return Some(Finding::note(
+            FindingKind::LateralSlip,
+            format!(
+                "a sideways slide in turns is not excluded: {numbers}, {:.1}σ, too little                  to be sure; if the robot slides (a skid-steer robot does), ℓx is {:+.1} mm                  off, more than its σ: `--lateral-slip` estimates the slide with the six                  parameters",
+                slip.significance(),
+                -1e3 * slip.l_x_shift
+            ),
+        ));
+    }
     (slip.significance() > SIGNIFICANCE && slip.k < 0.0).then(|| {
         Finding::warning(
             FindingKind::LateralSlip,
@@ -104,4 +119,33 @@ pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> 
             ),
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn slip(k: f64, sigma: f64, l_x_shift: f64) -> LateralSlip {
+        LateralSlip {
+            k,
+            sigma,
+            covariance_with_params: [0.0; 6],
+            l_x_shift,
+            turning_speed: 0.3,
+            turn_rate: 0.5,
+            applied: false,
+        }
+    }
+
+    #[test]
+    fn only_an_outward_significant_slide_that_moves_lx_is_found() {
+        let sigma_l_x = 0.001;
+        assert!(found(&slip(0.05, 0.01, 0.005), sigma_l_x));
+        // Inward: no wheel slides that way.
+        assert!(!found(&slip(-0.05, 0.01, -0.005), sigma_l_x));
+        // Below 4σ.
+        assert!(!found(&slip(0.035, 0.01, 0.005), sigma_l_x));
+        // Significant but moving ℓx by less than its σ.
+        assert!(!found(&slip(0.05, 0.01, 0.0005), sigma_l_x));
+    }
 }
