@@ -57,8 +57,8 @@ fn a_sliding_pioneer_biases_lx_unless_the_slide_is_estimated() {
     assert!(slide_found(&auto), "the check fires: {slip:?}");
     assert!(fixed.abs() < 3.0, "ℓx {fixed:+.2}σ");
     assert!((slip.k - K).abs() < 3.0 * slip.sigma, "{slip:?}");
-    for i in 0..6 {
-        let e = (auto.values()[i] - truth[i]) / auto.sigma[i];
+    for (i, t) in truth.iter().enumerate() {
+        let e = (auto.values()[i] - t) / auto.sigma[i];
         assert!(e.abs() < 3.0, "parameter {i}: {e:+.2}σ");
     }
     cleanup(&path);
