@@ -131,5 +131,9 @@ fn the_command_line_chooses_the_model() {
     let both = odocal(&["calibrate", &log, "--lateral-slip", "--no-lateral-slip"]);
     assert!(!both.status.success());
     assert!(common::stderr(&both).contains("cannot be used with"));
+    // Several logs are solved with six parameters: asked for the slide, refused.
+    let joint = odocal(&["calibrate", &log, &log, "--lateral-slip"]);
+    assert!(!joint.status.success());
+    assert!(common::stderr(&joint).contains("calibrate each log alone"));
     cleanup(&dir.join("run"));
 }

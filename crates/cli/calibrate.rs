@@ -175,6 +175,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let t_parse = Instant::now();
     let files = input.paths();
     check_own_laser(&args.own_laser, files.len())?;
+    if args.lateral_slip && (files.len() > 1 || input.read.scan_topic.len() > 1) {
+        anyhow::bail!(
+            "--lateral-slip estimates the slide for one log with one laser; several logs or \
+             lasers are calibrated with the six-parameter model only: calibrate each log \
+             alone (`odocal calibrate {} --lateral-slip`)",
+            files
+                .first()
+                .map_or_else(|| "LOG".into(), |p| p.display().to_string())
+        );
+    }
     let inputs = input.read_lasers()?;
     let parse_s = t_parse.elapsed().as_secs_f64();
     // One entry per laser's log: a bag read for several scan topics is one per topic.

@@ -102,7 +102,10 @@ pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> 
         return Some(Finding::note(
             FindingKind::LateralSlip,
             format!(
-                "a sideways slide in turns is not excluded: {numbers}, {:.1}σ, too little                  to be sure; if the robot slides (a skid-steer robot does), ℓx is {:+.1} mm                  off, more than its σ: `--lateral-slip` estimates the slide with the six                  parameters",
+                "a sideways slide in turns is not excluded: {numbers}, {:.1}σ, too little \
+                 to be sure; if the robot slides (a skid-steer robot does), ℓx is {:+.1} mm \
+                 off, more than its σ: `--lateral-slip` estimates the slide with the six \
+                 parameters",
                 slip.significance(),
                 -1e3 * slip.l_x_shift
             ),

@@ -147,37 +147,7 @@ pub(crate) fn predict_with_slide(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sample::ProfileSegment;
-    use odocal_geom::Pose2;
-
-    fn params() -> Params {
-        Params {
-            r_l: 0.031,
-            r_r: 0.029,
-            b: 0.31,
-            laser: Pose2::new(0.12, -0.05, 2.7),
-        }
-    }
-
-    fn seg(duration: f64, l: f64, r: f64) -> ProfileSegment {
-        ProfileSegment {
-            duration,
-            dphi_l: l,
-            dphi_r: r,
-        }
-    }
-
-    fn samples() -> Vec<Sample> {
-        vec![
-            Sample::from_rotations(0.5, 3.0, 4.0, Pose2::IDENTITY),
-            Sample::from_rotations(0.5, -3.0, 3.0, Pose2::IDENTITY),
-            Sample::from_rotations(0.5, 2.0, 2.0000001, Pose2::IDENTITY),
-            Sample::from_profile(
-                vec![seg(0.1, 1.0, 2.0), seg(0.2, -1.0, 2.5), seg(0.1, 0.5, 0.5)],
-                Pose2::IDENTITY,
-            ),
-        ]
-    }
+    use crate::kinematics::tests::{params, samples};
 
     #[test]
     fn a_constant_slide_is_the_arc_turned_outward() {
