@@ -137,3 +137,38 @@ fn the_command_line_chooses_the_model() {
     assert!(common::stderr(&joint).contains("calibrate each log alone"));
     cleanup(&dir.join("run"));
 }
+
+#[test]
+fn the_real_mines_logs_leave_the_slide_undetermined_and_say_so() {
+    // The real MinesRover logs (read from ../shared/real/mines beside the repository,
+    // skipped with a notice when absent): k is 2.2σ on exp1 and −1.3σ on exp2, so the
+    // default keeps the six-parameter estimate and exp1 gets a note naming
+    // --lateral-slip (the slide would move its ℓx by 18 mm, twice its σ); estimated,
+    // the two logs' k agree within 3σ.
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/real/mines");
+    let mut slides = Vec::new();
+    for name in ["exp1.log", "exp2.log"] {
+        let path = dir.join(name);
+        if !path.exists() {
+            println!("skipped: {} is absent", path.display());
+            return;
+        }
+        let auto = calibrate(&path, &with_model(SlideModel::Auto));
+        let slip = auto.lateral_slip.expect("the slide is checked");
+        assert!(!slip.applied, "{name}: {slip:?}");
+        let noted = auto
+            .health
+            .iter()
+            .any(|f| f.kind == FindingKind::LateralSlip && f.message.contains("--lateral-slip"));
+        assert_eq!(noted, name == "exp1.log", "{name}: {slip:?}");
+        let estimated = calibrate(&path, &with_model(SlideModel::Estimate));
+        slides.push(estimated.lateral_slip.expect("the slide is estimated"));
+    }
+    let (a, b) = (slides[0], slides[1]);
+    let z = (a.k - b.k) / a.sigma.hypot(b.sigma);
+    println!(
+        "k: exp1 {:.4} ± {:.4} s, exp2 {:.4} ± {:.4} s ({z:+.2}σ apart)",
+        a.k, a.sigma, b.k, b.sigma
+    );
+    assert!(z.abs() < 3.0);
+}

@@ -208,7 +208,7 @@ fn lateral_slip(v: &Value) -> Markup {
             @if let Some(k) = v["k"].as_f64() { " (a " (format!("{:.1}", k.atan().to_degrees())) "° slip angle at 1 rad/s)" }
             "; ℓx with the slide minus ℓx without: "
             @if let Some(d) = v["l_x_shift"].as_f64() { (num(&format!("{p}/l_x_shift"), d, 1e3, 2)) " mm" }
-            @if applied { "; estimated: the parameters and their σ include it." } @else { "; not found: the parameters are the differential-drive ones." }
+            @if applied { "; estimated: the parameters and their σ include it." } @else { "; not estimated: the parameters are the differential-drive ones." }
         }
     }
 }

@@ -296,7 +296,7 @@ fn slide_line(slip: &LateralSlip) -> String {
             -1e3 * slip.l_x_shift
         )
     } else {
-        format!("sideways slide in turns checked, not found: {k}")
+        format!("sideways slide in turns checked, not estimated: {k}")
     }
 }
 
