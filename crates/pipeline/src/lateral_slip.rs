@@ -62,10 +62,21 @@ pub fn check_and_apply(
     }
 }
 
-/// The finding for the slide of a calibration, when it was estimated or is
-/// significant; `None` otherwise.
+/// The finding for the slide of a calibration, when it was estimated, is
+/// significant, would matter, or was asked for and cannot be had; `None` otherwise.
 pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> {
-    let slip = calibration.lateral_slip.as_ref()?;
+    let Some(slip) = calibration.lateral_slip.as_ref() else {
+        // Asked for, but the data cannot give it: said, not left silent.
+        return (model == SlideModel::Estimate).then(|| {
+            Finding::warning(
+                FindingKind::LateralSlip,
+                "`--lateral-slip` asked for the sideways slide in turns, but this log \
+                 cannot determine it (no turns while translating at different speeds): \
+                 the estimate is the six-parameter one; drive the same arcs slowly and \
+                 fast",
+            )
+        });
+    };
     let numbers = format!(
         "v_y = −k·v·ω with k = {:.3} ± {:.3} s (a {:.1}° slip angle at 1 rad/s; at this \
          log's typical turn, {:.2} m/s and {:.2} rad/s, {:.0} mm/s sideways)",
@@ -138,6 +149,39 @@ mod tests {
             turn_rate: 0.5,
             applied: false,
         }
+    }
+
+    #[test]
+    fn a_slide_asked_for_that_the_data_cannot_give_is_said() {
+        use odocal_geom::Pose2;
+        use odocal_solver::{calibrate, Params, Predictor};
+        let truth = Params {
+            r_l: 0.03,
+            r_r: 0.031,
+            b: 0.3,
+            laser: Pose2::new(0.1, 0.02, 1.0),
+        };
+        let predictor = Predictor::new(&truth, true);
+        let samples: Vec<Sample> = (0..60)
+            .map(|k| {
+                let (l, r) = [(5.0, 5.0), (-4.0, 4.0), (2.0, 6.0)][k % 3];
+                let f = 1.0 + 0.01 * k as f64;
+                let s = Sample::from_rotations(0.5, l * f, r * f, Pose2::IDENTITY);
+                Sample {
+                    sm: Pose2::from_array(predictor.predict(&s)),
+                    ..s
+                }
+            })
+            .collect();
+        let mut cal = calibrate(&samples, &SolveOptions::default()).unwrap();
+        cal.lateral_slip = None;
+        let said = finding(&cal, SlideModel::Estimate).expect("a warning");
+        assert!(
+            said.message.contains("cannot determine it"),
+            "{}",
+            said.message
+        );
+        assert!(finding(&cal, SlideModel::Auto).is_none());
     }
 
     #[test]
