@@ -10,7 +10,9 @@ use crate::progress_bar::Bar;
 use crate::terminal::{out, outln, write_json_stdout};
 use anyhow::Context;
 use odocal_log::Log;
-use odocal_pipeline::{calibrate_log, calibrate_logs_with_lasers, laser_indices, Options, Trim};
+use odocal_pipeline::{
+    calibrate_log, calibrate_logs_with_lasers, laser_indices, Options, SlideModel, Trim,
+};
 use odocal_report::{
     build_joint_report, build_report, sha256_of_input, write_html, write_outputs, NominalLaserPose,
     Provenance,
@@ -55,6 +57,15 @@ impl From<TrimArg> for Trim {
     }
 }
 
+/// The odometry model of `--lateral-slip` / `--no-lateral-slip`.
+fn slide_model(args: &Args) -> SlideModel {
+    match (args.lateral_slip, args.no_lateral_slip) {
+        (true, _) => SlideModel::Estimate,
+        (_, true) => SlideModel::Off,
+        _ => SlideModel::Auto,
+    }
+}
+
 /// Arguments of `odocal calibrate`.
 #[derive(clap::Args, Debug)]
 pub struct Args {
@@ -73,6 +84,14 @@ pub struct Args {
     /// estimated from the residuals, which is what the reported σ assume).
     #[arg(long)]
     pub icp_covariance: bool,
+    /// Skid-steer robot: estimate the sideways slide in turns (v_y = −k·v·ω) as a
+    /// seventh parameter, always (by default it is estimated when the data show it).
+    #[arg(long, conflicts_with = "no_lateral_slip")]
+    pub lateral_slip: bool,
+    /// Differential drive only: neither check for the sideways slide in turns nor
+    /// estimate it.
+    #[arg(long)]
+    pub no_lateral_slip: bool,
     /// Estimate a constant clock offset between laser and encoders (within
     /// ±0.5 s of --time-offset, or ±--time-offset-range), before observability is judged.
     #[arg(long)]
@@ -180,6 +199,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let t_parse = Instant::now();
     let files = input.paths();
     check_own_laser(&args.own_laser, files.len())?;
+    if args.lateral_slip && (files.len() > 1 || input.read.scan_topic.len() > 1) {
+        anyhow::bail!(
+            "--lateral-slip estimates the slide for one log with one laser; several logs or \
+             lasers are calibrated with the six-parameter model only: calibrate each log \
+             alone (`odocal calibrate {} --lateral-slip`)",
+            files
+                .first()
+                .map_or_else(|| "LOG".into(), |p| p.display().to_string())
+        );
+    }
     let inputs = input.read_lasers()?;
     let parse_s = t_parse.elapsed().as_secs_f64();
     // One entry per laser's log: a bag read for several scan topics is one per topic.
@@ -244,6 +273,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .as_ref()
             .filter(|_| logs.len() == 1)
             .map(|l| l.laser_frame.clone()),
+        lateral_slip: slide_model(&args),
         ..Options::default()
     };
     opts.solve.trim = args.trim.into();

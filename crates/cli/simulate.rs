@@ -127,6 +127,10 @@ pub struct Args {
     /// Motor lag time constant (s).
     #[arg(long)]
     motor_tau: Option<f64>,
+    /// Sideways slide in turns (s), a skid-steer robot's: v_y = −K·v·ω (0.05 gives a
+    /// 3° slip angle at 1 rad/s).
+    #[arg(long, value_name = "K")]
+    lateral_slip: Option<f64>,
     /// Largest forward speed (m/s).
     #[arg(long)]
     max_speed: Option<f64>,
@@ -271,6 +275,7 @@ fn apply_overrides(c: &mut SimConfig, a: &Args) -> anyhow::Result<()> {
     set(&mut c.faults.drop_fraction, a.drop);
     set(&mut c.faults.garbage_fraction, a.garbage);
     set(&mut c.motors.time_constant, a.motor_tau);
+    set(&mut c.motors.lateral_slip, a.lateral_slip);
     set(&mut c.motion.max_speed, a.max_speed);
     set(&mut c.motion.max_turn_rate, a.max_turn_rate);
     set(&mut c.motion.clearance, a.clearance);

@@ -41,6 +41,8 @@ pub enum FindingKind {
     /// Odometry-only mode on odometry whose heading is not integrated from the wheels
     /// (a gyro's or a filter's).
     GyroHeading,
+    /// A skid-steer robot sliding sideways in its turns (`v_y = −k·v·ω`).
+    LateralSlip,
 }
 
 impl FindingKind {
@@ -62,6 +64,7 @@ impl FindingKind {
             FindingKind::ReadJitter => "read_jitter",
             FindingKind::LogAgreement => "log_agreement",
             FindingKind::GyroHeading => "gyro_heading",
+            FindingKind::LateralSlip => "lateral_slip",
         }
     }
 }

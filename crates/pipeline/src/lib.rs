@@ -23,10 +23,11 @@
 //! [`run`] (the
 //! whole, with timing), [`joint`] (several logs of one robot, one calibration), [`lasers`]
 //! (several lasers on it: the wheels shared, one ℓ per laser) and
-//! [`log_agreement`] (each of them against the joint estimate), [`samples`] (the samples and their tuples), [`estimate`] (the
-//! core numbers of a result), [`range_finder`] (common range finders recognised from
-//! their scans) and [`range_scale`] (the laser's range-scale σ that every calibrated
-//! distance carries).
+//! [`log_agreement`] (each of them against the joint estimate), [`lateral_slip`] (a
+//! skid-steer robot's sideways slide in turns: checked, and estimated when found),
+//! [`samples`] (the samples and their tuples), [`estimate`] (the core numbers of a
+//! result), [`range_finder`] (common range finders recognised from their scans) and
+//! [`range_scale`] (the laser's range-scale σ that every calibrated distance carries).
 
 #![deny(missing_docs)]
 
@@ -40,6 +41,7 @@ pub mod health;
 pub mod input_files;
 pub mod joint;
 pub mod lasers;
+pub mod lateral_slip;
 pub mod log_agreement;
 pub mod match_quality;
 pub mod matching;
@@ -68,6 +70,7 @@ pub use joint::{
     calibrate_logs, calibrate_logs_with_lasers, Contribution, JointError, JointOutcome,
 };
 pub use lasers::laser_indices;
+pub use lateral_slip::SlideModel;
 pub use odocal_solver::Trim;
 pub use options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 pub use progress::{NoProgress, Progress};

@@ -65,6 +65,10 @@ pub struct Options {
     /// The scans' frame (a bag's `header.frame_id`), when the input tells it: one more
     /// clue to recognise the range finder by.
     pub laser_frame: Option<String>,
+    /// The sideways slide of a skid-steer robot in turns: checked for and estimated
+    /// when found (default), always estimated, or neither (see
+    /// [`crate::lateral_slip`]).
+    pub lateral_slip: crate::lateral_slip::SlideModel,
 }
 
 impl Options {
@@ -104,6 +108,7 @@ impl Default for Options {
             odometry_only: false,
             laser_range_scale: None,
             laser_frame: None,
+            lateral_slip: Default::default(),
         }
     }
 }

@@ -383,6 +383,12 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         .collect();
     let solve_options = opts.solve_options();
     let mut calibration = odocal_solver::calibrate(&samples, &solve_options)?;
+    crate::lateral_slip::check_and_apply(
+        &mut calibration,
+        &samples,
+        &solve_options,
+        opts.lateral_slip,
+    );
     if let Some(check) = &synced.match_self_check {
         // The matcher's own error, when larger than the residuals' noise, scales σ.
         let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
@@ -619,6 +625,10 @@ pub fn calibrate_log(
     // Named in the findings only when the numbers are shown (--accept-weak): a
     // refusal names it as its cause.
     findings.extend(heading.map(|fit| fit.finding()));
+    findings.extend(crate::lateral_slip::finding(
+        &calibration,
+        opts.lateral_slip,
+    ));
 
     let t = Instant::now();
     let samples: Vec<_> = synced

@@ -21,7 +21,7 @@ pub(crate) struct Row {
 }
 
 /// The rows, in order. `time_offset_sigma_s` is shown with `time_offset_s`.
-pub(crate) const ROWS: [Row; 23] = [
+pub(crate) const ROWS: [Row; 24] = [
     Row { key: "log_contents", label: "What the input holds", meaning: "scans and wheel records read, lines skipped (lenient mode) and messages not understood" },
     Row { key: "samples_used", label: "Samples used", meaning: "scan pairs with their wheel rotations that entered the final estimate" },
     Row { key: "samples_synchronized", label: "Samples synchronized", meaning: "scan pairs matched and given the wheel rotations between their two scans, before outliers were trimmed" },
@@ -39,6 +39,7 @@ pub(crate) const ROWS: [Row; 23] = [
     Row { key: "cost_after", label: "Cost after refinement", meaning: "the same sum after the non-linear refinement (it should not be larger)" },
     Row { key: "observability", label: "Observability", meaning: "how well the motion in the log determines each parameter" },
     Row { key: "shared_scan_noise", label: "Scan noise shared by consecutive samples", meaning: "consecutive samples share a scan, so their matching errors are correlated; the σ's account for it" },
+    Row { key: "lateral_slip", label: "Sideways slide in turns", meaning: "a skid-steer robot's slide outward of its turns, v_y = −k·v·ω, checked on every log; when found (or asked with --lateral-slip) estimated with the six parameters, whose σ then include not knowing k" },
     Row { key: "consistency", label: "The two halves of the log", meaning: "each half calibrated alone; the difference compared with its σ" },
     Row { key: "covariance", label: "Covariance of the estimate", meaning: "the uncertainty of the six parameters and how they move together; its diagonal is σ²" },
     Row { key: "closed_form", label: "Closed-form solution", meaning: "the linear least-squares estimate the refinement started from" },
@@ -197,6 +198,21 @@ fn self_check(v: &Value) -> Markup {
     }
 }
 
+/// The sideways slide in words: k with its σ, the slip angle, whether it was applied.
+fn lateral_slip(v: &Value) -> Markup {
+    let p = "/lateral_slip";
+    let applied = v["applied"].as_bool().unwrap_or(false);
+    html! {
+        p {
+            "k = " (json(&v["k"], &format!("{p}/k"))) " ± " (json(&v["sigma"], &format!("{p}/sigma"))) " s"
+            @if let Some(k) = v["k"].as_f64() { " (a " (format!("{:.1}", k.atan().to_degrees())) "° slip angle at 1 rad/s)" }
+            "; ℓx with the slide minus ℓx without: "
+            @if let Some(d) = v["l_x_shift"].as_f64() { (num(&format!("{p}/l_x_shift"), d, 1e3, 2)) " mm" }
+            @if applied { "; estimated: the parameters and their σ include it." } @else { "; not estimated: the parameters are the differential-drive ones." }
+        }
+    }
+}
+
 /// The value of row `key` in the section's units.
 fn value(key: &str, x: &Value, all: &Value) -> Markup {
     let pointer = format!("/{}", escape_pointer(key));
@@ -231,6 +247,7 @@ fn value(key: &str, x: &Value, all: &Value) -> Markup {
                 }
             }
         },
+        "lateral_slip" => lateral_slip(x),
         "observability" => observability(x),
         "consistency" => consistency(x),
         "match_self_check" => self_check(x),

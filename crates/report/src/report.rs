@@ -8,7 +8,7 @@ use odocal_pipeline::consistency::Consistency;
 use odocal_pipeline::self_check::MatchSelfCheck;
 use odocal_pipeline::sync::DiscardCounts;
 use odocal_pipeline::{Estimate, Finding, FindingKind, Options, Outcome, RejectionCounts, Timing};
-use odocal_solver::{Constraint, Observability, SharedScanNoise, PARAMETER_NAMES};
+use odocal_solver::{Constraint, LateralSlip, Observability, SharedScanNoise, PARAMETER_NAMES};
 use serde::Serialize;
 use std::fmt;
 use std::path::Path;
@@ -73,6 +73,10 @@ pub struct Report {
     /// The noise shared by consecutive samples (through their common scan) that the
     /// covariance accounts for; absent when the samples were treated as independent.
     pub shared_scan_noise: Option<SharedScanNoise>,
+    /// The sideways slide of a skid-steer robot in turns, `v_y = −k·v·ω`, when it was
+    /// checked for: `k` (s) with its σ, and `applied` when the estimate includes it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lateral_slip: Option<LateralSlip>,
     /// Estimated clock offset (s, laser clock minus encoder clock), when asked.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_s: Option<f64>,
@@ -235,6 +239,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         observability: c.observability.clone(),
         consistency: outcome.consistency.clone(),
         shared_scan_noise: c.shared_scan_noise,
+        lateral_slip: c.lateral_slip,
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
         time_offset_sigma_s: outcome.offset.as_ref().and_then(|o| o.sigma),
         nominal: opts.initial_params.map(|p| p.to_vector()),
@@ -279,6 +284,25 @@ impl Report {
     /// The estimate as `[r_L, r_R, b, ℓx, ℓy, ℓθ]`.
     pub fn values(&self) -> [f64; 6] {
         self.params.to_array()
+    }
+}
+
+/// The summary's line on the sideways slide in turns.
+fn slide_line(slip: &LateralSlip) -> String {
+    let k = format!(
+        "k = {:.3} ± {:.3} s ({:.1}σ; {:.1}° slip angle at 1 rad/s)",
+        slip.k,
+        slip.sigma,
+        slip.significance(),
+        slip.slip_angle_deg(1.0)
+    );
+    if slip.applied {
+        format!(
+            "sideways slide in turns v_y = −k·v·ω estimated: {k}; without it ℓx would be {:+.1} mm off; the σ above include it",
+            -1e3 * slip.l_x_shift
+        )
+    } else {
+        format!("sideways slide in turns checked, not estimated: {k}")
     }
 }
 
@@ -411,6 +435,9 @@ impl fmt::Display for Report {
                 100.0 * n.shared_fraction[2],
                 n.shared_scans
             )?;
+        }
+        if let Some(slip) = &self.lateral_slip {
+            writeln!(f, "  {}", slide_line(slip))?;
         }
         writeln!(
             f,

@@ -166,6 +166,10 @@ pub struct Calibration {
     /// scans' times (the covariance then accounts for it); `None`: the samples
     /// were treated as independent.
     pub shared_scan_noise: Option<SharedScanNoise>,
+    /// The sideways slide in turns, when it was checked for (see
+    /// [`crate::fit_lateral_slip`]); `applied` when the estimate includes it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lateral_slip: Option<crate::LateralSlip>,
 }
 
 /// Closed form (step 1 and step 2) on all `samples`, without trimming: the
@@ -495,5 +499,6 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         refinement,
         observability,
         shared_scan_noise,
+        lateral_slip: None,
     })
 }

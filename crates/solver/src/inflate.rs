@@ -1,6 +1,6 @@
 //! Scaling a calibration's covariance when its noise model is found too small by a
-//! measurement outside the solver (the scan matcher's own error, say): the σ, the
-//! verdicts and the sentence follow.
+//! measurement outside the solver (the scan matcher's own error, say): the σ (the
+//! slide's too), the verdicts and the sentence follow.
 
 use crate::calibrate::Calibration;
 use crate::constraints::Constraints;
@@ -18,6 +18,10 @@ pub fn inflate_sigma(calibration: &mut Calibration, factor: f64) {
         for v in row.iter_mut() {
             *v *= f2;
         }
+    }
+    if let Some(slip) = calibration.lateral_slip.as_mut() {
+        slip.sigma *= factor;
+        slip.covariance_with_params = slip.covariance_with_params.map(|c| c * f2);
     }
     let obs = &mut calibration.observability;
     let constraints = Constraints(std::array::from_fn(|i| {

@@ -373,10 +373,12 @@ pub fn predict_with_jacobian(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn params() -> Params {
+    /// A robot with unequal radii and a displaced, rotated laser (also used by the
+    /// slide's tests).
+    pub(crate) fn params() -> Params {
         Params {
             r_l: 0.031,
             r_r: 0.029,
@@ -393,7 +395,8 @@ mod tests {
         }
     }
 
-    fn samples() -> Vec<Sample> {
+    /// Constant-speed and profiled samples: arcs, a straight run, a spin, tiny turns.
+    pub(crate) fn samples() -> Vec<Sample> {
         vec![
             Sample::from_rotations(0.5, 3.0, 4.0, Pose2::IDENTITY),
             Sample::from_rotations(0.5, 3.0, 3.0, Pose2::IDENTITY),

@@ -17,6 +17,8 @@
 //!    [`Observability`] report; degenerate data give [`SolveError::NotExcited`];
 //!    the laser's range scale, which the data cannot tell, is added to it by
 //!    [`with_range_scale`].
+//! 6. optionally, for skid-steer robots, a seventh parameter: the sideways slide in
+//!    turns `v_y = −k·v·ω` ([`fit_lateral_slip`], [`LateralSlip`]).
 //!
 //! Entry point: [`calibrate`]; for a robot with several lasers (wheels shared, one ℓ
 //! per laser), [`calibrate_lasers`].
@@ -52,6 +54,7 @@ mod error;
 mod inflate;
 mod kinematics;
 mod lasers;
+mod lateral_slip;
 mod linalg;
 mod noise;
 mod normal_equations;
@@ -63,6 +66,7 @@ mod range_scale;
 pub mod refine;
 mod sample;
 mod shared_scans;
+mod slide_kinematics;
 pub mod step1;
 pub mod step2;
 pub mod trimming;
@@ -79,6 +83,7 @@ pub use error::SolveError;
 pub use inflate::inflate_sigma;
 pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
 pub use lasers::{calibrate_lasers, LasersCalibration};
+pub use lateral_slip::{fit_lateral_slip, LateralSlip, SlideFit};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
 pub use observability::{
     MotionContent, Observability, ParameterReport, Verdict, MOTION_CLASS_RATIO,

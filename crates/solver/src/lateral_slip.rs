@@ -1,0 +1,379 @@
+//! A seventh parameter for skid-steer robots: the sideways slide in turns,
+//! `v_y = −k·v·ω` (see [`crate::slide_kinematics`] for the model and why a slide
+//! proportional to ω alone is only a shift of ℓx).
+//!
+//! [`fit_lateral_slip`] refines the six parameters and `k` together by maximum
+//! likelihood on the samples a [`Calibration`] used, with its noise model, from its
+//! estimate and `k = 0`; [`SlideFit::apply`] puts the result into the calibration:
+//! the parameters at the joint optimum and their covariance widened by what not
+//! knowing `k` adds. The six-parameter solve itself is untouched.
+
+use crate::calibrate::{Calibration, SolveOptions};
+use crate::constraints::Constraints;
+use crate::kinematics::residual_of;
+use crate::linalg::unit_diagonal;
+use crate::noise::NoiseWeights;
+use crate::normal_equations::NormalEquations;
+use crate::observability::{parameter_reports, sentence, wheel_signs};
+use crate::params::Params;
+use crate::sample::Sample;
+use crate::slide_kinematics::predict_with_slide;
+use nalgebra::{SMatrix, SVector};
+use serde::Serialize;
+
+type Matrix7 = SMatrix<f64, 7, 7>;
+
+/// Largest number of Levenberg–Marquardt iterations.
+const MAX_ITERATIONS: usize = 50;
+
+/// Relative decrease of the cost below which the iteration stops.
+const RELATIVE_TOLERANCE: f64 = 1e-12;
+
+/// Turn rate (rad/s) and forward speed (m/s) above which a sample counts as turning
+/// while translating, for the typical speeds of the sentence.
+const TURNING_RATE: f64 = 0.1;
+const MOVING_SPEED: f64 = 0.02;
+
+/// The slide `v_y = −k·v·ω` estimated from a log.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LateralSlip {
+    /// `k` (s): positive when the robot slides outward of its turns.
+    pub k: f64,
+    /// Standard deviation of `k` (s).
+    pub sigma: f64,
+    /// Covariance of `k` with `(r_L, r_R, b, ℓx, ℓy, ℓθ)`.
+    pub covariance_with_params: [f64; 6],
+    /// ℓx with the slide estimated minus ℓx without it (m): what ignoring the
+    /// slide moves ℓx by.
+    pub l_x_shift: f64,
+    /// Median forward speed |v| (m/s) of the samples that turn while translating
+    /// (|ω| above 0.1 rad/s, |v| above 0.02 m/s); NaN without such samples.
+    pub turning_speed: f64,
+    /// Median turn rate |ω| (rad/s) of the same samples.
+    pub turn_rate: f64,
+    /// Whether the calibration's parameters and covariance are those of the model
+    /// with the slide (else it was only checked for).
+    pub applied: bool,
+}
+
+impl LateralSlip {
+    /// `|k| / σ`.
+    pub fn significance(&self) -> f64 {
+        if self.sigma > 0.0 {
+            self.k.abs() / self.sigma
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The slip angle `atan(k·ω)` (degrees) at a turn rate `omega` (rad/s): the angle
+    /// between the robot's heading and its velocity.
+    pub fn slip_angle_deg(&self, omega: f64) -> f64 {
+        (self.k * omega).atan().to_degrees()
+    }
+}
+
+/// The joint estimate of the six parameters and the slide.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SlideFit {
+    /// The six parameters at the joint optimum.
+    pub params: Params,
+    /// Their covariance with `k` unknown (6×6 block of the 7×7 covariance).
+    pub covariance: [[f64; 6]; 6],
+    /// The slide.
+    pub slip: LateralSlip,
+    /// Weighted cost at the joint optimum.
+    pub cost: f64,
+}
+
+impl SlideFit {
+    /// Replaces `calibration`'s estimate, covariance, verdicts and costs by the
+    /// joint ones and records the slide as applied.
+    pub fn apply(self, calibration: &mut Calibration) {
+        let obs = &mut calibration.observability;
+        let constraints = Constraints(std::array::from_fn(|i| {
+            obs.parameters
+                .get(i)
+                .map_or(Default::default(), |p| p.constraint)
+        }));
+        obs.parameters = parameter_reports(&self.params, &self.covariance, &constraints);
+        obs.sentence = sentence(&obs.parameters, &obs.motion);
+        obs.wheel_signs = wheel_signs(&self.params);
+        calibration.params = self.params;
+        calibration.j = self.params.j();
+        calibration.covariance = self.covariance;
+        calibration.cost_after = self.cost;
+        let dof = (3 * calibration.samples_used).saturating_sub(7).max(1);
+        calibration.reduced_chi2 = self.cost / dof as f64;
+        calibration.lateral_slip = Some(LateralSlip {
+            applied: true,
+            ..self.slip
+        });
+    }
+}
+
+/// Cost, Gauss–Newton matrix and gradient of the seven-parameter model over the
+/// samples `calibration` used, with the priors and held parameters of `constraints`.
+fn normal_equations(
+    samples: &[Sample],
+    used: &[usize],
+    x: &[f64; 7],
+    weights: &NoiseWeights,
+    constraints: &Constraints,
+    use_profile: bool,
+) -> (f64, [[f64; 7]; 7], [f64; 7]) {
+    let params = Params::from_vector([x[0], x[1], x[2], x[3], x[4], x[5]]);
+    let mut h = [[0.0; 7]; 7];
+    let mut g = [0.0; 7];
+    let mut cost = 0.0;
+    for &i in used {
+        let s = &samples[i];
+        let (p, jac) = predict_with_slide(&params, x[6], s, use_profile);
+        let e = residual_of(p, &s.sm.to_array());
+        let w: [[f64; 3]; 3] = match weights {
+            NoiseWeights::Shared(d) => {
+                std::array::from_fn(|r| std::array::from_fn(|c| if r == c { d[r] } else { 0.0 }))
+            }
+            NoiseWeights::PerSample(info) => info[i],
+        };
+        for r in 0..3 {
+            for c in 0..3 {
+                if w[r][c] == 0.0 {
+                    continue;
+                }
+                cost += e[r] * w[r][c] * e[c];
+                for a in 0..7 {
+                    let wa = jac[r][a] * w[r][c];
+                    g[a] += wa * e[c];
+                    for b in a..7 {
+                        h[a][b] += wa * jac[c][b];
+                    }
+                }
+            }
+        }
+    }
+    for a in 0..7 {
+        for b in 0..a {
+            h[a][b] = h[b][a];
+        }
+    }
+    // Priors and held parameters on the six, through the six-parameter rules.
+    let mut ne = NormalEquations {
+        cost,
+        h: std::array::from_fn(|a| std::array::from_fn(|b| h[a][b])),
+        g: std::array::from_fn(|a| g[a]),
+    };
+    constraints.apply_to(&mut ne, &params);
+    for a in 0..6 {
+        h[a][..6].copy_from_slice(&ne.h[a]);
+        g[a] = ne.g[a];
+        if constraints.is_held(a) {
+            h[a][6] = 0.0;
+            h[6][a] = 0.0;
+        }
+    }
+    (ne.cost, h, g)
+}
+
+/// The median of `values` (NaN when empty).
+fn median(mut values: Vec<f64>) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    let mid = values.len() / 2;
+    *values.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// Refines the six parameters and the slide `k` together on the samples
+/// `calibration` used (`samples` are the ones it was computed from, with the same
+/// `options`). `None` when the seven-parameter information is singular (no turns
+/// at different speeds) or the estimate is not finite.
+pub fn fit_lateral_slip(
+    samples: &[Sample],
+    calibration: &Calibration,
+    options: &SolveOptions,
+) -> Option<SlideFit> {
+    let used: Vec<usize> = (0..samples.len())
+        .filter(|&i| calibration.used.get(i).copied().unwrap_or(false))
+        .collect();
+    let weights = NoiseWeights::from_samples(samples)
+        .unwrap_or_else(|| NoiseWeights::from_sigmas(calibration.sm_sigma));
+    let constraints = &options.constraints;
+    let use_profile = options.use_profile;
+    let start = calibration.params.to_vector();
+    let mut x = [
+        start[0], start[1], start[2], start[3], start[4], start[5], 0.0,
+    ];
+    let ne = |x: &[f64; 7]| normal_equations(samples, &used, x, &weights, constraints, use_profile);
+    let (mut cost, mut h, mut g) = ne(&x);
+    let mut lambda = 1e-6;
+    for _ in 0..MAX_ITERATIONS {
+        if !(cost.is_finite() && cost > 0.0) {
+            break;
+        }
+        let hm = Matrix7::from_fn(|a, b| h[a][b]);
+        let (hs, s) = unit_diagonal(&hm);
+        let gs = SVector::<f64, 7>::from_fn(|a, _| g[a] * s[a]);
+        let Some(chol) = (hs + Matrix7::identity() * lambda).cholesky() else {
+            lambda *= 10.0;
+            if lambda > 1e12 {
+                break;
+            }
+            continue;
+        };
+        let step = -chol.solve(&gs);
+        let predicted = -2.0 * gs.dot(&step) - (hs * step).dot(&step);
+        if predicted <= RELATIVE_TOLERANCE * cost {
+            break;
+        }
+        let trial: [f64; 7] = std::array::from_fn(|a| x[a] + step[a] * s[a]);
+        let (tc, th, tg) = ne(&trial);
+        if tc.is_finite() && tc <= cost {
+            let decrease = cost - tc;
+            (x, cost, h, g) = (trial, tc, th, tg);
+            lambda = (lambda * 0.1).max(1e-12);
+            if decrease <= RELATIVE_TOLERANCE * cost {
+                break;
+            }
+        } else {
+            lambda *= 10.0;
+            if lambda > 1e12 {
+                break;
+            }
+        }
+    }
+    if !x.iter().all(|v| v.is_finite()) {
+        return None;
+    }
+    // The 7×7 covariance in unit-diagonal scaling; held rows are decoupled.
+    let hm = Matrix7::from_fn(|a, b| h[a][b]);
+    let (hs, s) = unit_diagonal(&hm);
+    if s[6] == 0.0 {
+        return None;
+    }
+    let inverse = hs.cholesky()?.inverse();
+    let cov = |a: usize, b: usize| inverse[(a, b)] * s[a] * s[b];
+    let var_k = cov(6, 6);
+    if !(var_k.is_finite() && var_k > 0.0) {
+        return None;
+    }
+    // Not knowing k adds u·uᵀ/var_k to the six's covariance (u their covariance with
+    // k): the six-parameter covariance (with its shared-scan sandwich) plus that.
+    let cross: [f64; 6] = std::array::from_fn(|a| {
+        if constraints.is_held(a) {
+            0.0
+        } else {
+            cov(a, 6)
+        }
+    });
+    let covariance = std::array::from_fn(|a| {
+        std::array::from_fn(|b| calibration.covariance[a][b] + cross[a] * cross[b] / var_k)
+    });
+    let params = Params::from_vector([x[0], x[1], x[2], x[3], x[4], x[5]]);
+    let (mut speeds, mut rates) = (Vec::new(), Vec::new());
+    for &i in &used {
+        let s = &samples[i];
+        let v = 0.5 * (params.r_l * s.dphi_l + params.r_r * s.dphi_r) / s.t;
+        let w = (params.r_r * s.dphi_r - params.r_l * s.dphi_l) / params.b / s.t;
+        if w.abs() > TURNING_RATE && v.abs() > MOVING_SPEED {
+            speeds.push(v.abs());
+            rates.push(w.abs());
+        }
+    }
+    Some(SlideFit {
+        params,
+        covariance,
+        slip: LateralSlip {
+            k: x[6],
+            sigma: var_k.sqrt(),
+            covariance_with_params: cross,
+            l_x_shift: params.laser.x - calibration.params.laser.x,
+            turning_speed: median(speeds),
+            turn_rate: median(rates),
+            applied: false,
+        },
+        cost,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::calibrate::calibrate;
+    use odocal_geom::Pose2;
+
+    /// Samples of a drive with spins, slow and fast arcs and straight runs, ŝ
+    /// predicted with the slide `k` plus a deterministic pseudo-noise.
+    fn samples(truth: &Params, k: f64) -> Vec<Sample> {
+        let mut out = Vec::new();
+        let mut seed = 12345u64;
+        let mut noise = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2e-4
+        };
+        for i in 0..300 {
+            let (l, r) = [
+                (5.0, 5.0),
+                (-4.0, 4.0),
+                (2.0, 6.0),
+                (8.0, 14.0),
+                (14.0, 8.0),
+                (1.0, 3.0),
+            ][i % 6];
+            let f = 1.0 + 0.002 * (i % 17) as f64;
+            let s = Sample::from_rotations(0.4, l * f, r * f, Pose2::IDENTITY);
+            let (p, _) = predict_with_slide(truth, k, &s, true);
+            out.push(Sample {
+                sm: Pose2::new(p[0] + noise(), p[1] + noise(), p[2] + 0.1 * noise()),
+                ..s
+            });
+        }
+        out
+    }
+
+    fn truth() -> Params {
+        Params {
+            r_l: 0.03,
+            r_r: 0.031,
+            b: 0.3,
+            laser: Pose2::new(0.1, 0.02, 0.4),
+        }
+    }
+
+    #[test]
+    fn the_slide_is_recovered_and_moves_lx_back() {
+        let (truth, k) = (truth(), 0.05);
+        let samples = samples(&truth, k);
+        let options = SolveOptions::default();
+        let mut cal = calibrate(&samples, &options).unwrap();
+        let biased = cal.params.laser.x - truth.laser.x;
+        let fit = fit_lateral_slip(&samples, &cal, &options).unwrap();
+        let slip = fit.slip;
+        assert!((slip.k - k).abs() < 3.0 * slip.sigma, "{slip:?}");
+        assert!(slip.significance() > 10.0, "{slip:?}");
+        fit.apply(&mut cal);
+        let sx = cal.covariance[3][3].sqrt();
+        assert!((cal.params.laser.x - truth.laser.x).abs() < 3.0 * sx);
+        assert!(
+            biased.abs() > 3.0 * sx,
+            "ignoring the slide biases ℓx: {biased}"
+        );
+        assert!(cal.lateral_slip.unwrap().applied);
+    }
+
+    #[test]
+    fn no_slide_gives_k_near_zero_and_keeps_the_estimate() {
+        let truth = truth();
+        let samples = samples(&truth, 0.0);
+        let options = SolveOptions::default();
+        let cal = calibrate(&samples, &options).unwrap();
+        let fit = fit_lateral_slip(&samples, &cal, &options).unwrap();
+        assert!(fit.slip.significance() < 4.0, "{:?}", fit.slip);
+        for i in 0..6 {
+            let d = (fit.params.to_vector()[i] - cal.params.to_vector()[i]).abs();
+            assert!(d < 2.0 * cal.covariance[i][i].sqrt(), "parameter {i}: {d}");
+            // σ never shrinks by adding a parameter.
+            assert!(fit.covariance[i][i] >= cal.covariance[i][i]);
+        }
+    }
+}
