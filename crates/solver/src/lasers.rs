@@ -601,9 +601,10 @@ fn combine(
     Some((params, covariance))
 }
 
-/// The constraints laser `k` sees: the wheels' of `shared`, its own ℓ's (`shared`'s
-/// for the first laser, `more[k - 1]` for the others, free beyond `more`).
-fn laser_constraints(shared: &Constraints, more: &[[Constraint; 3]], k: usize) -> Constraints {
+/// The constraints laser `k` sees in [`calibrate_lasers_constrained`]: the wheels' of
+/// `shared`, its own ℓ's (`shared`'s for the first laser, `more[k - 1]` for the
+/// others, free beyond `more`).
+pub fn laser_constraints(shared: &Constraints, more: &[[Constraint; 3]], k: usize) -> Constraints {
     let mut c = *shared;
     if k > 0 {
         let own = more.get(k - 1).copied().unwrap_or_default();

@@ -75,7 +75,9 @@ pub use covariance::INFORMATION_SINGULAR_RATIO;
 pub use error::SolveError;
 pub use inflate::inflate_sigma;
 pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
-pub use lasers::{calibrate_lasers, calibrate_lasers_constrained, LasersCalibration};
+pub use lasers::{
+    calibrate_lasers, calibrate_lasers_constrained, laser_constraints, LasersCalibration,
+};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
 pub use observability::{
     MotionContent, Observability, ParameterReport, Verdict, MOTION_CLASS_RATIO,
