@@ -210,9 +210,9 @@ fn own_laser_out_of_range_is_refused_with_the_count() {
 }
 
 #[test]
-fn several_scan_topics_are_for_calibrate_only() {
+fn match_writes_each_lasers_samples_to_its_own_file() {
     let dir = temp_dir("two-lidars-match");
-    let out = dir.join("s.tuple");
+    let (front, rear) = (dir.join("front.tuple"), dir.join("rear.tuple"));
     let o = odocal(&[
         "match",
         TWO_LIDARS,
@@ -221,10 +221,166 @@ fn several_scan_topics_are_for_calibrate_only() {
         "--scan-topic",
         "/scan_rear",
         "--out",
-        out.to_str().unwrap(),
+        front.to_str().unwrap(),
+        "--out",
+        rear.to_str().unwrap(),
+    ]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    // Each file holds its laser's samples: solved alone, each gives its own laser's
+    // pose (front near ℓθ 0, rear turned by about π), as `calibrate` does per topic.
+    for (file, topic, theta) in [(&front, "/scan_front", 0.012), (&rear, "/scan_rear", 3.1)] {
+        let text = std::fs::read_to_string(file).unwrap();
+        let samples = text.lines().filter(|l| !l.trim().is_empty()).count();
+        assert!(samples > 30, "{topic}: {samples} samples\n{err}");
+        assert!(
+            err.contains(&format!("samples written to {}", file.display())),
+            "{err}"
+        );
+        let v = json(&odocal(&[
+            "solve",
+            file.to_str().unwrap(),
+            "--json",
+            "--accept-weak",
+        ]));
+        let got = v["l_theta"].as_f64().expect("l_theta");
+        assert!(wrap_angle(got - theta).abs() < 0.05, "{topic}: ℓθ {got}");
+    }
+    // One --out for two lasers: refused, with the command that works.
+    let o = odocal(&[
+        "match",
+        TWO_LIDARS,
+        "--scan-topic",
+        "/scan_front",
+        "--scan-topic",
+        "/scan_rear",
+        "--out",
+        front.to_str().unwrap(),
     ]);
     let err = stderr(&o);
     assert!(!o.status.success(), "{err}");
-    assert!(err.contains("odocal calibrate"), "{err}");
+    assert!(err.contains("--out front.tuple --out rear.tuple"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn fix_and_prior_name_a_laser_with_at() {
+    let o = odocal(&[
+        "calibrate",
+        TWO_LIDARS,
+        "--scan-topic",
+        "/scan_front",
+        "--scan-topic",
+        "/scan_rear",
+        "--fix",
+        "l_x@2=-0.12",
+        "--prior",
+        "l_theta@2=3.1+-0.01",
+        "--prior",
+        "b=0.1614+-0.0005",
+        "--json",
+    ]);
+    let v = json(&o);
+    let rear = &v["lasers"][1];
+    assert_eq!(rear["l_x"].as_f64(), Some(-0.12), "{rear}");
+    assert_eq!(rear["sigma"][0].as_f64(), Some(0.0), "{rear}");
+    // The first laser's ℓx is not held; the wheel prior shows on b.
+    assert!(v["lasers"][0]["sigma"][0].as_f64().unwrap() > 0.0);
+    let free = json(&odocal(&[
+        "calibrate",
+        TWO_LIDARS,
+        "--scan-topic",
+        "/scan_front",
+        "--scan-topic",
+        "/scan_rear",
+        "--json",
+    ]));
+    let sigma_b = |v: &Value| v["sigma"][2].as_f64().expect("σ of b");
+    assert!(
+        sigma_b(&v) < 0.8 * sigma_b(&free),
+        "{} vs {}",
+        sigma_b(&v),
+        sigma_b(&free)
+    );
+    // ℓθ of laser 2 with a 0.01 rad prior: its σ is at most the prior's.
+    assert!(rear["sigma"][2].as_f64().unwrap() <= 0.01, "{rear}");
+    // A laser that does not exist, a wheel with a laser number, a laser number with
+    // one laser: each refused with what to give instead.
+    for (args, want) in [
+        (
+            vec![
+                "--scan-topic",
+                "/scan_front",
+                "--scan-topic",
+                "/scan_rear",
+                "--fix",
+                "l_y@3=0",
+            ],
+            "this calibration has 2 laser(s)",
+        ),
+        (
+            vec![
+                "--scan-topic",
+                "/scan_front",
+                "--scan-topic",
+                "/scan_rear",
+                "--fix",
+                "b@2=0.16",
+            ],
+            "give b without @2",
+        ),
+        (
+            vec!["--scan-topic", "/scan_front", "--fix", "l_x@2=0.1"],
+            "has 1 laser(s)",
+        ),
+        (
+            vec!["--scan-topic", "/scan_front", "--fix", "l_x@two=0.1"],
+            "the laser's number from 1",
+        ),
+    ] {
+        let mut all = vec!["calibrate", TWO_LIDARS];
+        all.extend(args);
+        let o = odocal(&all);
+        let err = stderr(&o);
+        assert!(!o.status.success(), "{all:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(err.contains(want), "{all:?}: {err}");
+    }
+}
+
+#[test]
+fn the_second_lasers_nominal_pose_comes_from_tf_static() {
+    let truth: Value = serde_json::from_str(
+        &std::fs::read_to_string("fixtures/bags/turtlebot_two_lidars.truth.json").unwrap(),
+    )
+    .unwrap();
+    let o = odocal(&[
+        "calibrate",
+        TWO_LIDARS,
+        "--scan-topic",
+        "/scan_front",
+        "--scan-topic",
+        "/scan_rear",
+        "--nominal",
+        "0.033,0.033,0.16",
+        "--json",
+    ]);
+    let err = stderr(&o);
+    let v = json(&o);
+    // The rear laser's frame is in /tf_static: its row names the source and the
+    // pose (the truth rounded as a CAD model gives it), and stderr says it seeds
+    // that laser's first guesses.
+    let rear = &v["lasers"][1]["nominal"];
+    assert_eq!(rear["source"], "/tf_static", "{v}");
+    assert_eq!(rear["laser_frame"], "rear_laser", "{rear}");
+    let want = pose(&truth["lasers"][1]);
+    assert!((pose(rear).x - want.x).abs() < 1e-3 && (pose(rear).theta - want.theta).abs() < 0.01);
+    assert_eq!(v["lasers"][0]["nominal"]["laser_frame"], "laser", "{v}");
+    assert!(
+        err.contains("laser 2: nominal pose from the bag's /tf_static (base_link -> rear_laser)"),
+        "{err}"
+    );
+    // Seeded from the bag, the rear laser still lands on its truth.
+    let got = pose(&v["lasers"][1]);
+    assert!((got.x - want.x).abs() < 0.005 && wrap_angle(got.theta - want.theta).abs() < 0.02);
 }

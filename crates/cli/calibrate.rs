@@ -7,11 +7,12 @@ use crate::nominal::{describe, odometry_only_mode};
 use crate::output_paths::{check_dir_output, check_file_output};
 use crate::partial_args::PartialArgs;
 use crate::progress_bar::Bar;
-use crate::terminal::{out, outln, write_json_stdout};
+use crate::terminal::{errln, out, outln, write_json_stdout};
 use anyhow::Context;
 use odocal_log::Log;
 use odocal_pipeline::{
-    calibrate_log, calibrate_logs_with_lasers, laser_indices, Options, SlideModel, Trim,
+    calibrate_log, calibrate_logs_with_lasers, laser_indices, LaserSetup, Options, SlideModel,
+    Trim,
 };
 use odocal_report::{
     build_joint_report, build_report, sha256_of_input, write_html, write_outputs, NominalLaserPose,
@@ -181,6 +182,18 @@ fn range_scale_percent(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A bag's nominal laser pose as the report shows it.
+fn nominal_pose(l: odocal_bag::NominalLaser) -> NominalLaserPose {
+    NominalLaserPose {
+        source: l.source,
+        base_frame: l.base_frame,
+        laser_frame: l.laser_frame,
+        l_x: l.x,
+        l_y: l.y,
+        l_theta: l.theta,
+    }
+}
+
 /// Runs `odocal calibrate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
@@ -236,8 +249,28 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         })
         .collect();
     let laser_of_log = laser_indices(&laser_keys);
-    // The laser's nominal pose from the first bag with static transforms.
-    let laser = inputs.iter().find_map(|(_, r)| r.nominal_laser.clone());
+    let lasers = laser_of_log.iter().max().map_or(1, |m| m + 1);
+    let constraints = args.partial.laser_constraints()?;
+    if constraints.more.len() >= lasers {
+        anyhow::bail!(
+            "--fix/--prior NAME@{}: this calibration has {lasers} laser(s); a laser's \
+             number counts from 1 in the order of the --scan-topic given, or of the logs \
+             given --own-laser after the first log's laser",
+            constraints.more.len() + 1
+        );
+    }
+    // Each laser's nominal pose from its first bag with static transforms (the
+    // first laser's is the one `--nominal` with three values completes).
+    let nominal_of = |k: usize| {
+        inputs
+            .iter()
+            .zip(&laser_of_log)
+            .filter(|(_, &l)| l == k)
+            .find_map(|((_, r), _)| r.nominal_laser.clone())
+    };
+    let laser = nominal_of(0);
+    let other_nominal: Vec<Option<odocal_bag::NominalLaser>> =
+        (1..lasers).map(nominal_of).collect();
     // The bag's wheel joint states and IMU topics, for a gyro-heading refusal.
     let heading_sources = inputs.iter().find_map(|(_, r)| r.heading_sources.clone());
     let refused = |e| match with_joint_states_command(e, heading_sources.as_ref()) {
@@ -278,7 +311,35 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     opts.solve.trim = args.trim.into();
     opts.solve.refine = !args.no_refine;
-    opts.solve.constraints = args.partial.constraints()?;
+    opts.solve.constraints = constraints.shared;
+    let setup = LaserSetup {
+        of_log: laser_of_log.clone(),
+        nominal: other_nominal
+            .iter()
+            .map(|n| {
+                n.as_ref()
+                    .map(|l| odocal_geom::Pose2::new(l.x, l.y, l.theta))
+            })
+            .collect(),
+        constraints: constraints.more.clone(),
+    };
+    if opts.initial_params.is_some() {
+        for (k, n) in other_nominal.iter().enumerate() {
+            if let Some(l) = n {
+                errln!(
+                    "laser {}: nominal pose from the bag's {} ({} -> {}): l_x = {:.4} m, \
+                     l_y = {:.4} m, l_theta = {:.4} rad",
+                    k + 2,
+                    l.source,
+                    l.base_frame,
+                    l.laser_frame,
+                    l.x,
+                    l.y,
+                    l.theta
+                );
+            }
+        }
+    }
 
     let bar = Bar::for_stderr();
     let (mut outcome, mut report) = if let [log] = &logs[..] {
@@ -289,10 +350,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (outcome, report)
     } else {
         let named: Vec<(&str, &Log)> = names.iter().map(String::as_str).zip(&logs).collect();
-        let joint =
-            pool.install(|| calibrate_logs_with_lasers(&named, &laser_of_log, &opts, &bar))?;
+        let joint = pool.install(|| calibrate_logs_with_lasers(&named, &setup, &opts, &bar))?;
         let all: Vec<&Log> = logs.iter().collect();
         let mut report = build_joint_report(&paths, &names, &topics, &all, &opts, &joint);
+        for (row, n) in report
+            .lasers
+            .iter_mut()
+            .zip(std::iter::once(&laser).chain(&other_nominal))
+        {
+            row.nominal = n.clone().map(nominal_pose);
+        }
         for ((row, path), checksum) in report.logs.iter_mut().zip(&paths).zip(&mut checksums) {
             let (sha256, bytes) = match checksum.take() {
                 Some(c) => c,
@@ -307,14 +374,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     outcome.timing.parse = parse_s;
     report.timing_s.parse = parse_s;
     report.odometry_only = odometry_only.is_some();
-    report.nominal_laser = laser.map(|l| NominalLaserPose {
-        source: l.source,
-        base_frame: l.base_frame,
-        laser_frame: l.laser_frame,
-        l_x: l.x,
-        l_y: l.y,
-        l_theta: l.theta,
-    });
+    report.nominal_laser = laser.map(nominal_pose);
     let (input_sha256, input_bytes) = match checksums[0].take() {
         Some(c) => c,
         None => sha256_of_input(paths[0])

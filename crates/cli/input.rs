@@ -62,21 +62,6 @@ impl InputArgs {
             .collect()
     }
 
-    /// Reads every log given, each with the reading options of [`ReadArgs`], with what
-    /// the single read of each tells besides the log (see [`ReadArgs::read_input`]).
-    pub fn read_logs(&self) -> anyhow::Result<Vec<ReadInput>> {
-        self.paths()
-            .into_iter()
-            .map(|path| {
-                ReadArgs {
-                    log: path.to_path_buf(),
-                    ..self.read.clone()
-                }
-                .read_input()
-            })
-            .collect()
-    }
-
     /// Every log given, read once per laser ([`ReadArgs::read_input_lasers`]: a bag
     /// with several `--scan-topic` gives one input per topic), each with the position
     /// (from 0) of its log among [`InputArgs::paths`].

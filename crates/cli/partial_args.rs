@@ -2,17 +2,19 @@
 //! known values (`--fix`), Gaussian priors (`--prior`) and `--accept-weak`.
 
 use anyhow::Context;
-use odocal_solver::{parse_fix, parse_prior, Constraints};
+use odocal_solver::{parse_fix, parse_prior, Constraint, Constraints};
 
 /// `--fix`, `--prior` and `--accept-weak`.
 #[derive(clap::Args, Debug, Default)]
 pub struct PartialArgs {
     /// Hold a parameter at a known value and solve the others: NAME=VALUE with NAME
-    /// one of r_L, r_R, b, l_x, l_y, l_theta (SI units: m, rad). Repeatable.
+    /// one of r_L, r_R, b, l_x, l_y, l_theta (SI units: m, rad). Repeatable. With
+    /// several lasers (`calibrate`), l_x@K=VALUE names laser K's (from 1, in the order
+    /// of the --scan-topic or of the logs' own lasers); l_x alone is laser 1's.
     #[arg(long = "fix", value_name = "NAME=VALUE", allow_hyphen_values = true)]
     pub fix: Vec<String>,
     /// Give a parameter a Gaussian prior: NAME=VALUE±SIGMA (or NAME=VALUE+-SIGMA;
-    /// SI units). Repeatable.
+    /// SI units). Repeatable. l_x@K=VALUE±SIGMA: laser K's, as with --fix.
     #[arg(
         long = "prior",
         value_name = "NAME=VALUE±SIGMA",
@@ -25,19 +27,91 @@ pub struct PartialArgs {
     pub accept_weak: bool,
 }
 
+/// Held parameters and priors of a calibration with one or several lasers.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LaserConstraints {
+    /// The wheels' and the first laser's.
+    pub shared: Constraints,
+    /// Per laser after the first (`more[0]`: laser 2's), its (ℓx, ℓy, ℓθ); lasers
+    /// beyond the vector are free.
+    pub more: Vec<[Constraint; 3]>,
+}
+
 impl PartialArgs {
-    /// The constraints of `--fix` and `--prior`.
+    /// The constraints of `--fix` and `--prior` for one laser; `NAME@K` (another
+    /// laser's) is an error that says where it applies.
     pub fn constraints(&self) -> anyhow::Result<Constraints> {
-        let mut c = Constraints::default();
-        for text in &self.fix {
-            let (name, held) = parse_fix(text).context("--fix")?;
-            c.set(&name, held).context("--fix")?;
+        let all = self.laser_constraints()?;
+        if let Some(k) = all
+            .more
+            .iter()
+            .position(|c| c.iter().any(|c| *c != Constraint::Free))
+        {
+            anyhow::bail!(
+                "--fix/--prior NAME@{}: a laser number names one of several lasers of \
+                 `odocal calibrate` (repeated --scan-topic, or --own-laser); here there is \
+                 one laser: drop the @{}",
+                k + 2,
+                k + 2
+            );
         }
-        for text in &self.prior {
-            let (name, prior) = parse_prior(text).context("--prior")?;
-            c.set(&name, prior).context("--prior")?;
+        Ok(all.shared)
+    }
+
+    /// The constraints of `--fix` and `--prior` with laser numbers: `NAME@K=…` (K
+    /// from 1) puts laser K's ℓ parameter, `NAME=…` and `NAME@1=…` the wheels' or
+    /// the first laser's.
+    pub fn laser_constraints(&self) -> anyhow::Result<LaserConstraints> {
+        let mut all = LaserConstraints::default();
+        for (flag, texts) in [("--fix", &self.fix), ("--prior", &self.prior)] {
+            for text in texts {
+                let (laser, plain) = split_laser(text).context(flag)?;
+                let (name, constraint) = if flag == "--fix" {
+                    parse_fix(&plain)
+                } else {
+                    parse_prior(&plain)
+                }
+                .context(flag)?;
+                if laser <= 1 {
+                    all.shared.set(&name, constraint).context(flag)?;
+                    continue;
+                }
+                let i = odocal_solver::parameter_index(&name).unwrap_or(0);
+                if i < 3 {
+                    anyhow::bail!(
+                        "{flag} '{text}': the wheels are shared by every laser; give \
+                         {name} without @{laser}"
+                    );
+                }
+                if all.more.len() < laser - 1 {
+                    all.more.resize(laser - 1, [Constraint::Free; 3]);
+                }
+                let slot = &mut all.more[laser - 2][i - 3];
+                if *slot != Constraint::Free {
+                    anyhow::bail!("{flag} '{text}': {name} of laser {laser} is held or given a prior more than once");
+                }
+                *slot = constraint;
+            }
         }
-        Ok(c)
+        Ok(all)
+    }
+}
+
+/// `NAME@K=REST` as `(K, "NAME=REST")`; `(0, text)` without `@K`. K is a laser's
+/// number from 1.
+fn split_laser(text: &str) -> anyhow::Result<(usize, String)> {
+    let Some((name, rest)) = text.split_once('=') else {
+        return Ok((0, text.to_string()));
+    };
+    let Some((base, laser)) = name.split_once('@') else {
+        return Ok((0, text.to_string()));
+    };
+    match laser.trim().parse::<usize>() {
+        Ok(k) if k >= 1 => Ok((k, format!("{base}={rest}"))),
+        _ => anyhow::bail!(
+            "'{text}': after @ comes the laser's number from 1 (e.g. l_x@2=-0.12 holds \
+             laser 2's ℓx), got '{laser}'"
+        ),
     }
 }
 

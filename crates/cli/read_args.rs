@@ -18,8 +18,8 @@ pub struct ReadArgs {
     #[arg(value_parser = log_path)]
     pub log: PathBuf,
     /// Bag: the sensor_msgs/LaserScan topic (default: the only one). Repeat it for a
-    /// robot with several lasers (`calibrate` only): each topic is one laser with its
-    /// own ℓ, sweep timing and clock offset; the wheels are shared.
+    /// robot with several lasers (`calibrate` and `match`): each topic is one laser
+    /// with its own ℓ, sweep timing and clock offset; the wheels are shared.
     #[arg(long, value_name = "TOPIC")]
     pub scan_topic: Vec<String>,
     /// Bag: the sensor_msgs/JointState topic with the wheel joints (default: the only one).
@@ -130,8 +130,8 @@ impl ReadArgs {
             }
             if self.scan_topic.len() > 1 {
                 anyhow::bail!(
-                    "{}: several --scan-topic ({}) are read by `odocal calibrate` only, one \
-                     laser each; here give one",
+                    "{}: several --scan-topic ({}) are read by `odocal calibrate` and \
+                     `odocal match`, one laser each; here give one",
                     self.log.display(),
                     self.scan_topic.join(", ")
                 );

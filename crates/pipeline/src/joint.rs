@@ -9,7 +9,7 @@
 use crate::consistency::Consistency;
 use crate::error::PipelineError;
 use crate::finding::Finding;
-use crate::lasers::{comparison_options, solve, Solved};
+use crate::lasers::{comparison_options, solve, LaserSetup, Solved};
 use crate::log_agreement::{check_log, information_shares};
 use crate::options::{Options, MIN_SAMPLES};
 use crate::progress::Progress;
@@ -100,40 +100,36 @@ pub fn calibrate_logs(
     opts: &Options,
     progress: &dyn Progress,
 ) -> Result<JointOutcome, JointError> {
-    calibrate_logs_with_lasers(logs, &vec![0; logs.len()], opts, progress)
+    calibrate_logs_with_lasers(logs, &LaserSetup::one_laser(logs.len()), opts, progress)
 }
 
-/// [`calibrate_logs`] with each log's laser: logs with equal `laser_of_log` numbers
-/// share a laser (renumbered from 0, the first log's, in order of appearance;
+/// [`calibrate_logs`] with each log's laser (`lasers.of_log`: logs with equal numbers
+/// share a laser, renumbered from 0, the first log's, in order of appearance;
 /// [`crate::laser_indices`] numbers them from keys). The wheels are shared; each
-/// laser gets its own ℓ. The laser pose of `opts.initial_params` (scan matching's
-/// first guesses) is taken as the first laser's: the logs of other lasers bootstrap
-/// their guesses. Held parameters and priors are refused with more than one laser.
+/// laser gets its own ℓ. `opts.initial_params` and `opts.solve.constraints` are the
+/// wheels' and the first laser's; the other lasers' first guesses and held
+/// parameters or priors are `lasers`' (without a first guess, a laser's logs
+/// bootstrap their guesses).
 pub fn calibrate_logs_with_lasers(
     logs: &[(&str, &Log)],
-    laser_of_log: &[usize],
+    lasers: &LaserSetup,
     opts: &Options,
     progress: &dyn Progress,
 ) -> Result<JointOutcome, JointError> {
-    let lenient = Options {
-        accept_weak: true,
-        ..opts.clone()
-    };
-    // The nominal laser pose (first guesses of scan matching) is the first laser's:
-    // the logs of other lasers find their guesses by the bootstrap instead.
-    let other_laser = Options {
-        initial_params: None,
-        ..lenient.clone()
-    };
     // Numbered densely from the first log's laser, whatever numbers were given.
-    let laser_of_log = crate::lasers::laser_indices(laser_of_log);
+    let laser_of_log = crate::lasers::laser_indices(&lasers.of_log);
     let mut outcomes = Vec::with_capacity(logs.len());
     for (index, (name, log)) in logs.iter().enumerate() {
-        let own = match laser_of_log.get(index) {
-            Some(&k) if k > 0 => &other_laser,
-            _ => &lenient,
+        let k = laser_of_log.get(index).copied().unwrap_or(0);
+        // The log's laser's first guess and constraints; its own estimate is never
+        // refused (only compared).
+        let mut own = Options {
+            accept_weak: true,
+            initial_params: lasers.initial_params(k, opts.initial_params),
+            ..opts.clone()
         };
-        let outcome = calibrate_log(log, own, progress).map_err(|source| JointError::Log {
+        own.solve.constraints = lasers.constraints_of(k, &opts.solve.constraints);
+        let outcome = calibrate_log(log, &own, progress).map_err(|source| JointError::Log {
             index,
             name: name.to_string(),
             source,
@@ -167,7 +163,7 @@ pub fn calibrate_logs_with_lasers(
         .zip(&laser_of_log)
         .flat_map(|(o, &k)| std::iter::repeat_n(k, o.synced.samples.len()))
         .collect();
-    let solved = solve(&samples, &laser_of, &solve_options)
+    let solved = solve(&samples, &laser_of, &solve_options, &lasers.constraints)
         .map_err(|e| JointError::Joint(PipelineError::from(e).with_faults(&health)))?;
     let agreements: Vec<Consistency> = logs
         .iter()
@@ -177,7 +173,8 @@ pub fn calibrate_logs_with_lasers(
             let view = solved.view(k);
             let alone =
                 solved.lasers.is_some() && laser_of_log.iter().filter(|&&j| j == k).count() == 1;
-            let compared = comparison_options(&solve_options, &view, alone);
+            let constraints = lasers.constraints_of(k, &solve_options.constraints);
+            let compared = comparison_options(&solve_options, constraints, &view, alone);
             check_log(&o.calibration, &view, &compared, name, alone)
         })
         .collect();

@@ -69,7 +69,7 @@ pub use input_files::InputFiles;
 pub use joint::{
     calibrate_logs, calibrate_logs_with_lasers, Contribution, JointError, JointOutcome,
 };
-pub use lasers::laser_indices;
+pub use lasers::{laser_indices, LaserSetup};
 pub use lateral_slip::SlideModel;
 pub use odocal_solver::Trim;
 pub use options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};

@@ -75,6 +75,11 @@ pub struct LaserRow {
     /// (from the joint covariance of ℓ₁ and ℓ_k, cross terms included); identity with
     /// zero covariance for the first laser.
     pub from_first: Between,
+    /// The laser's nominal pose from its bag (`/tf_static` or the URDF for its scan
+    /// topic's frame), when the bag has one: scan matching's first guess with
+    /// `--nominal` (see docs/frames.md).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nominal: Option<crate::report::NominalLaserPose>,
 }
 
 impl Report {
@@ -159,6 +164,7 @@ pub fn laser_rows(
                     sigma: sigma(&tc),
                     covariance: tc,
                 },
+                nominal: None,
             }
         })
         .collect()
@@ -172,18 +178,25 @@ pub(crate) fn write_laser_table(f: &mut fmt::Formatter<'_>, rows: &[LaserRow]) -
     )?;
     for (k, r) in rows.iter().enumerate() {
         let name = r.topic.clone().unwrap_or_else(|| r.logs.join(", "));
+        // A held parameter (zero variance) says so instead of "± 0".
+        let pm = |sigma: f64, scale: f64, digits: usize, unit: &str| {
+            if sigma == 0.0 {
+                " held".to_string()
+            } else {
+                format!(" ± {:.*}{unit}", digits, sigma * scale)
+            }
+        };
         write!(
             f,
-            "    laser {} {}: ℓx {:+.2} ± {:.2} mm, ℓy {:+.2} ± {:.2} mm, ℓθ {:+.3}° ± {:.3}° \
-             ({} samples, {} used)",
+            "    laser {} {}: ℓx {:+.2}{} mm, ℓy {:+.2}{} mm, ℓθ {:+.3}°{} ({} samples, {} used)",
             k + 1,
             name,
             r.l_x * 1e3,
-            r.sigma[0] * 1e3,
+            pm(r.sigma[0], 1e3, 2, ""),
             r.l_y * 1e3,
-            r.sigma[1] * 1e3,
+            pm(r.sigma[1], 1e3, 2, ""),
             r.l_theta.to_degrees(),
-            r.sigma[2].to_degrees(),
+            pm(r.sigma[2], 180.0 / std::f64::consts::PI, 3, "°"),
             r.samples,
             r.samples_used
         )?;
@@ -212,6 +225,18 @@ pub(crate) fn write_laser_table(f: &mut fmt::Formatter<'_>, rows: &[LaserRow]) -
             Some(sensor) => write!(f, "; {sensor}, no range-scale figure")?,
             None if scale.applies() => write!(f, "; {}", scale.label())?,
             None => write!(f, "; laser not recognised")?,
+        }
+        if let Some(n) = &r.nominal {
+            write!(
+                f,
+                "; nominal from {} ({} -> {}): ℓx {:+.1} mm, ℓy {:+.1} mm, ℓθ {:+.2}°",
+                n.source,
+                n.base_frame,
+                n.laser_frame,
+                n.l_x * 1e3,
+                n.l_y * 1e3,
+                n.l_theta.to_degrees()
+            )?;
         }
         writeln!(f)?;
     }

@@ -10,7 +10,7 @@
 //! Lasers never share a scan, so their scores are independent.
 
 use crate::calibrate::{calibrate, Calibration, NoiseSource, SolveOptions};
-use crate::constraints::Constraints;
+use crate::constraints::{Constraint, Constraints};
 use crate::error::SolveError;
 use crate::kinematics::{residual_of, Predictor};
 use crate::linalg::information_from_covariance;
@@ -55,6 +55,9 @@ pub struct LasersCalibration {
     /// block of the joint covariance and the verdicts from it; the rest (trimming,
     /// noise, motion content) from the first laser's own solve.
     pub first: Calibration,
+    /// Per laser: the parameters held or given priors as that laser sees them (the
+    /// wheels' shared by all, its own ℓ's).
+    pub constraints: Vec<Constraints>,
 }
 
 impl LasersCalibration {
@@ -215,12 +218,25 @@ fn joint_names(k: usize) -> Vec<String> {
 
 /// Calibrates one robot with several lasers: `laser_of[i]` is the laser (0, 1, …) of
 /// `samples[i]`; every laser index below the largest must have samples. The wheels
-/// are shared, each laser gets its own ℓ. Parameters held or given priors in
-/// `options.constraints` are not supported here (an error): hold them per laser.
+/// are shared, each laser gets its own ℓ. `options.constraints` hold the wheels and
+/// the first laser's ℓ (or give them priors); the other lasers' ℓ are free (see
+/// [`calibrate_lasers_constrained`]).
 pub fn calibrate_lasers(
     samples: &[Sample],
     laser_of: &[usize],
     options: &SolveOptions,
+) -> Result<LasersCalibration, SolveError> {
+    calibrate_lasers_constrained(samples, laser_of, options, &[])
+}
+
+/// [`calibrate_lasers`] with the other lasers' ℓ held or given priors: `more[j]` is
+/// (ℓx, ℓy, ℓθ) of laser `j + 1` (lasers beyond `more` free). The wheels' constraints
+/// (`options.constraints`, shared by every laser) and each prior count once.
+pub fn calibrate_lasers_constrained(
+    samples: &[Sample],
+    laser_of: &[usize],
+    options: &SolveOptions,
+    more: &[[Constraint; 3]],
 ) -> Result<LasersCalibration, SolveError> {
     if laser_of.len() != samples.len() {
         return Err(SolveError::Numerical(format!(
@@ -229,14 +245,25 @@ pub fn calibrate_lasers(
             laser_of.len()
         )));
     }
-    if !options.constraints.is_empty() {
-        return Err(SolveError::Numerical(
-            "held parameters and priors are not supported with several lasers yet: \
-             calibrate each laser on its own to hold parameters"
-                .into(),
-        ));
-    }
     let k_lasers = laser_of.iter().max().map_or(0, |m| m + 1);
+    if more.len() >= k_lasers.max(1) {
+        return Err(SolveError::Numerical(format!(
+            "constraints given for laser {} but the samples come from {k_lasers} laser(s)",
+            more.len() + 1
+        )));
+    }
+    let constraints: Vec<Constraints> = (0..k_lasers)
+        .map(|k| laser_constraints(&options.constraints, more, k))
+        .collect();
+    let joint_constraints: Vec<Constraint> = (0..3 + 3 * k_lasers)
+        .map(|i| {
+            if i < 3 {
+                options.constraints.0[i]
+            } else {
+                constraints[(i - 3) / 3].0[3 + (i - 3) % 3]
+            }
+        })
+        .collect();
     // Each laser's samples, with their indices in the input.
     let mut members: Vec<Vec<usize>> = vec![Vec::new(); k_lasers];
     for (i, &k) in laser_of.iter().enumerate() {
@@ -248,9 +275,13 @@ pub fn calibrate_lasers(
     };
     let mut own = Vec::with_capacity(k_lasers);
     let mut own_samples: Vec<Vec<Sample>> = Vec::with_capacity(k_lasers);
-    for idx in &members {
+    for (idx, c) in members.iter().zip(&constraints) {
         let group: Vec<Sample> = idx.iter().map(|&i| samples[i].clone()).collect();
-        own.push(calibrate(&group, &lenient)?);
+        let options = SolveOptions {
+            constraints: *c,
+            ..lenient
+        };
+        own.push(calibrate(&group, &options)?);
         own_samples.push(group);
     }
     // Start: wheels weighted by each laser's information on them, each laser's own ℓ.
@@ -282,6 +313,11 @@ pub fn calibrate_lasers(
         let l = c.params.laser;
         start[3 + 3 * k..6 + 3 * k].copy_from_slice(&[l.x, l.y, l.theta]);
     }
+    for (v, c) in start.iter_mut().zip(&joint_constraints) {
+        if let Constraint::Held(h) = c {
+            *v = *h;
+        }
+    }
     let groups: Vec<Group> = own
         .iter()
         .zip(&own_samples)
@@ -295,9 +331,9 @@ pub fn calibrate_lasers(
         .collect();
 
     let (params, cost_before, cost_after, iterations, h) = if options.refine {
-        refine_joint(&groups, start)
+        refine_joint(&groups, start, &joint_constraints)
     } else {
-        let (cost, h, _) = normal_equations(&groups, &start);
+        let (cost, h, _) = constrained_normal_equations(&groups, &start, &joint_constraints);
         (start, cost, cost, 0, h)
     };
     if !params.iter().all(|v| v.is_finite()) {
@@ -311,13 +347,17 @@ pub fn calibrate_lasers(
                    calibrate each laser on its own to see which motion is missing"
             .into(),
     })?;
-    let (covariance, shared) = sandwich(&groups, &params, &inverse);
+    let inverse = zero_held(inverse, &joint_constraints);
+    let (covariance, shared) = sandwich(&groups, &params, &inverse, &joint_constraints);
     // With scans shared by consecutive samples the lasers' true covariances are the
     // sandwiches, not H⁻¹, and an H-weighted fit mixes the lasers' wheels with the
     // wrong weights (the two-lidar fixture: σ_b 1.01 mm jointly, 0.71 mm from the
     // rear lidar alone). Then the estimate is the lasers' own estimates combined by
     // generalized least squares with those covariances (first-order ML for them).
-    let (params, covariance) = match shared.then(|| combine(&own)).flatten() {
+    let (params, covariance) = match shared
+        .then(|| combine(&own, &constraints, &joint_constraints))
+        .flatten()
+    {
         Some(combined) => combined,
         None => (params, covariance),
     };
@@ -339,6 +379,7 @@ pub fn calibrate_lasers(
         cost_before,
         cost_after,
         iterations,
+        constraints,
     };
     out.first = out.view(0);
     Ok(out)
@@ -353,8 +394,7 @@ impl LasersCalibration {
         let params = self.params_of(k);
         let covariance = self.covariance_of(k);
         let mut c = self.own[k].clone();
-        // No parameter is held or has a prior here (refused by `calibrate_lasers`).
-        let reports = parameter_reports(&params, &covariance, &Constraints::default());
+        let reports = parameter_reports(&params, &covariance, &self.constraints[k]);
         c.observability.sentence = sentence(&reports, &c.observability.motion);
         c.observability.parameters = reports;
         c.observability.wheel_signs = wheel_signs(&params);
@@ -375,10 +415,14 @@ impl LasersCalibration {
 
 /// Levenberg–Marquardt over all `3 + 3K` parameters from `start`: the estimate, the
 /// costs before and after, the iterations and the information at the estimate.
-fn refine_joint(groups: &[Group], start: Vec<f64>) -> (Vec<f64>, f64, f64, usize, DMatrix<f64>) {
+fn refine_joint(
+    groups: &[Group],
+    start: Vec<f64>,
+    constraints: &[Constraint],
+) -> (Vec<f64>, f64, f64, usize, DMatrix<f64>) {
     let n = start.len();
     let mut params = start;
-    let (mut cost, mut h, mut g) = normal_equations(groups, &params);
+    let (mut cost, mut h, mut g) = constrained_normal_equations(groups, &params, constraints);
     let cost_before = cost;
     let mut lambda = 1e-6;
     let mut iterations = 0;
@@ -406,7 +450,7 @@ fn refine_joint(groups: &[Group], start: Vec<f64>) -> (Vec<f64>, f64, f64, usize
         for k in 0..(n - 3) / 3 {
             trial[5 + 3 * k] = wrap_angle(trial[5 + 3 * k]);
         }
-        let (t_cost, t_h, t_g) = normal_equations(groups, &trial);
+        let (t_cost, t_h, t_g) = constrained_normal_equations(groups, &trial, constraints);
         if t_cost.is_finite() && t_cost <= cost {
             let decrease = cost - t_cost;
             (params, cost, h, g) = (trial, t_cost, t_h, t_g);
@@ -449,11 +493,22 @@ fn invert(h: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     Some(DMatrix::from_fn(n, n, |i, j| inv_s[(i, j)] * s[i] * s[j]))
 }
 
-/// `H⁻¹ M H⁻¹` with `M` the score's covariance: per laser, its shared-scan score
-/// (when its samples carry scan times) or its block of `H` (independent samples).
-fn sandwich(groups: &[Group], params: &[f64], inverse: &DMatrix<f64>) -> (DMatrix<f64>, bool) {
+/// `H⁻¹ (M + P) H⁻¹` with `M` the score's covariance: per laser, its shared-scan score
+/// (when its samples carry scan times) or its block of `H` (independent samples), and
+/// `P` the priors' information. `inverse` is `H⁻¹` with held rows zero.
+fn sandwich(
+    groups: &[Group],
+    params: &[f64],
+    inverse: &DMatrix<f64>,
+    constraints: &[Constraint],
+) -> (DMatrix<f64>, bool) {
     let n = params.len();
     let mut meat = DMatrix::zeros(n, n);
+    for (i, c) in constraints.iter().enumerate() {
+        if let Constraint::Prior { sigma, .. } = c {
+            meat[(i, i)] += 1.0 / (sigma * sigma);
+        }
+    }
     let mut any_shared = false;
     for (k, group) in groups.iter().enumerate() {
         let ix = LasersCalibration::indices(k);
@@ -488,30 +543,119 @@ fn sandwich(groups: &[Group], params: &[f64], inverse: &DMatrix<f64>) -> (DMatri
 
 /// The lasers' own estimates (wheels and ℓ_k, covariance C_k) combined by generalized
 /// least squares: `x = (Σ P_kᵀ C_k⁻¹ P_k)⁻¹ Σ P_kᵀ C_k⁻¹ θ_k` with `P_k` selecting the
-/// wheels and ℓ_k, and its covariance `(Σ P_kᵀ C_k⁻¹ P_k)⁻¹`; `None` when a
-/// covariance cannot be inverted.
-fn combine(own: &[Calibration]) -> Option<(Vec<f64>, DMatrix<f64>)> {
+/// free ones of the wheels and ℓ_k, and its covariance `(Σ P_kᵀ C_k⁻¹ P_k)⁻¹`; `None`
+/// when a covariance cannot be inverted. Held parameters keep their values (zero
+/// variance); a wheel's prior, in every laser's own estimate, is counted once.
+fn combine(
+    own: &[Calibration],
+    constraints: &[Constraints],
+    joint: &[Constraint],
+) -> Option<(Vec<f64>, DMatrix<f64>)> {
     let n = 3 + 3 * own.len();
     let mut a = DMatrix::zeros(n, n);
     let mut b = DVector::zeros(n);
-    for (k, c) in own.iter().enumerate() {
+    for ((k, c), held) in own.iter().enumerate().zip(constraints) {
         let ix = LasersCalibration::indices(k);
-        let ck = DMatrix::from_fn(6, 6, |i, j| c.covariance[i][j]);
+        let free: Vec<usize> = (0..6).filter(|&i| !held.is_held(i)).collect();
+        let ck = DMatrix::from_fn(free.len(), free.len(), |i, j| {
+            c.covariance[free[i]][free[j]]
+        });
         let info = invert(&ck)?;
-        let theta = DVector::from_column_slice(&c.params.to_vector());
+        let v = c.params.to_vector();
+        let theta = DVector::from_fn(free.len(), |i, _| v[free[i]]);
         let weighted = &info * theta;
-        for i in 0..6 {
-            b[ix[i]] += weighted[i];
-            for j in 0..6 {
-                a[(ix[i], ix[j])] += info[(i, j)];
+        for (i, &fi) in free.iter().enumerate() {
+            b[ix[fi]] += weighted[i];
+            for (j, &fj) in free.iter().enumerate() {
+                a[(ix[fi], ix[fj])] += info[(i, j)];
             }
         }
     }
-    let covariance = invert(&a)?;
-    let x = &covariance * b;
+    let repeated = own.len().saturating_sub(1) as f64;
+    for (i, c) in joint.iter().enumerate() {
+        match *c {
+            Constraint::Held(v) => {
+                a[(i, i)] = 1.0;
+                b[i] = v;
+            }
+            Constraint::Prior { mean, sigma } if i < 3 => {
+                let w = repeated / (sigma * sigma);
+                a[(i, i)] -= w;
+                b[i] -= w * mean;
+            }
+            _ => {}
+        }
+    }
+    let inverse = invert(&a)?;
+    let x = &inverse * b;
+    let covariance = zero_held(inverse, joint);
     let mut params: Vec<f64> = x.iter().copied().collect();
+    for (v, c) in params.iter_mut().zip(joint) {
+        if let Constraint::Held(h) = c {
+            *v = *h;
+        }
+    }
     for k in 0..own.len() {
         params[5 + 3 * k] = wrap_angle(params[5 + 3 * k]);
     }
     Some((params, covariance))
+}
+
+/// The constraints laser `k` sees in [`calibrate_lasers_constrained`]: the wheels' of
+/// `shared`, its own ℓ's (`shared`'s for the first laser, `more[k - 1]` for the
+/// others, free beyond `more`).
+pub fn laser_constraints(shared: &Constraints, more: &[[Constraint; 3]], k: usize) -> Constraints {
+    let mut c = *shared;
+    if k > 0 {
+        let own = more.get(k - 1).copied().unwrap_or_default();
+        c.0[3..6].copy_from_slice(&own);
+    }
+    c
+}
+
+/// [`normal_equations`] with the priors added and the held parameters decoupled
+/// (zero gradient, unit diagonal, zero coupling), so that a step leaves them in place.
+fn constrained_normal_equations(
+    groups: &[Group],
+    params: &[f64],
+    constraints: &[Constraint],
+) -> (f64, DMatrix<f64>, DVector<f64>) {
+    let (mut cost, mut h, mut g) = normal_equations(groups, params);
+    let n = params.len();
+    for (i, c) in constraints.iter().enumerate() {
+        match *c {
+            Constraint::Free => {}
+            Constraint::Held(_) => {
+                for j in 0..n {
+                    h[(i, j)] = 0.0;
+                    h[(j, i)] = 0.0;
+                }
+                h[(i, i)] = 1.0;
+                g[i] = 0.0;
+            }
+            Constraint::Prior { mean, sigma } => {
+                let d = if i >= 3 && i % 3 == 2 {
+                    wrap_angle(params[i] - mean)
+                } else {
+                    params[i] - mean
+                };
+                let w = 1.0 / (sigma * sigma);
+                cost += w * d * d;
+                g[i] += w * d;
+                h[(i, i)] += w;
+            }
+        }
+    }
+    (cost, h, g)
+}
+
+/// `c` with the rows and columns of held parameters set to zero.
+fn zero_held(mut c: DMatrix<f64>, constraints: &[Constraint]) -> DMatrix<f64> {
+    for (i, k) in constraints.iter().enumerate() {
+        if matches!(k, Constraint::Held(_)) {
+            c.row_mut(i).fill(0.0);
+            c.column_mut(i).fill(0.0);
+        }
+    }
+    c
 }

@@ -82,7 +82,9 @@ pub use covariance::INFORMATION_SINGULAR_RATIO;
 pub use error::SolveError;
 pub use inflate::inflate_sigma;
 pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
-pub use lasers::{calibrate_lasers, LasersCalibration};
+pub use lasers::{
+    calibrate_lasers, calibrate_lasers_constrained, laser_constraints, LasersCalibration,
+};
 pub use lateral_slip::{fit_lateral_slip, LateralSlip, SlideFit};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
 pub use observability::{

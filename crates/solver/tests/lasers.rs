@@ -10,7 +10,10 @@ mod common;
 use common::{add_noise, exact_samples, rng, test_robot};
 use nalgebra::DMatrix;
 use odocal_geom::Pose2;
-use odocal_solver::{calibrate, calibrate_lasers, Params, Sample, SolveOptions};
+use odocal_solver::{
+    calibrate, calibrate_lasers, calibrate_lasers_constrained, Constraint, Params, Sample,
+    SolveOptions, Verdict,
+};
 use rand::rngs::StdRng;
 
 /// The test robot's wheels with a front laser and a rear laser turned by π.
@@ -103,6 +106,19 @@ fn one_laser_agrees_with_the_single_laser_solve() {
     assert_eq!(joint.used, single.used);
 }
 
+/// The joint estimate minus the truth (headings wrapped).
+fn joint_error(params: &[f64], truth: &[f64]) -> Vec<f64> {
+    (0..params.len())
+        .map(|i| {
+            if i >= 3 && i % 3 == 2 {
+                angle_diff(params[i], truth[i])
+            } else {
+                params[i] - truth[i]
+            }
+        })
+        .collect()
+}
+
 /// Normalized estimation error squared of `err` under `cov`.
 fn nees(err: &[f64], cov: &DMatrix<f64>) -> f64 {
     let e = nalgebra::DVector::from_column_slice(err);
@@ -122,15 +138,7 @@ fn monte_carlo(runs: usize, seed: u64) -> (f64, f64, f64) {
     for _ in 0..runs {
         let (samples, laser_of) = drive(&mut r, &[front, rear], 150, Some([0.002, 0.002, 0.004]));
         let cal = calibrate_lasers(&samples, &laser_of, &SolveOptions::default()).unwrap();
-        let err: Vec<f64> = (0..9)
-            .map(|i| {
-                if i == 5 || i == 8 {
-                    angle_diff(cal.params[i], truth[i])
-                } else {
-                    cal.params[i] - truth[i]
-                }
-            })
-            .collect();
+        let err = joint_error(&cal.params, &truth);
         let cov = DMatrix::from_fn(9, 9, |i, j| cal.covariance[i][j]);
         joint_sum += nees(&err, &cov);
         let (t, c) = cal.from_first(1);
@@ -193,4 +201,170 @@ fn laser_without_samples_is_an_error_not_a_panic() {
     let mut laser_of = vec![0; samples.len()];
     laser_of[0] = 2;
     assert!(calibrate_lasers(&samples, &laser_of, &SolveOptions::default()).is_err());
+}
+
+/// `samples` with consecutive scan times (each sample's second scan the next one's
+/// first), so that the joint solve takes its shared-scan path (the lasers' own
+/// estimates combined by generalized least squares).
+fn chained(mut samples: Vec<Sample>) -> Vec<Sample> {
+    for (i, s) in samples.iter_mut().enumerate() {
+        s.scan_times = Some([i as f64, i as f64 + 1.0]);
+    }
+    samples
+}
+
+#[test]
+fn second_laser_held_and_wheel_prior_counted_once() {
+    let (front, rear) = two_lasers();
+    let mut r = rng(7);
+    let (samples, laser_of) = drive(&mut r, &[front, rear], 150, Some([0.002, 0.002, 0.004]));
+    for shared in [false, true] {
+        let samples = if shared {
+            chained(samples.clone())
+        } else {
+            samples.clone()
+        };
+        let free = calibrate_lasers(&samples, &laser_of, &SolveOptions::default()).unwrap();
+        let sigma_b = free.covariance[2][2].sqrt();
+        // The rear laser's ℓx held at a value 5 mm off the truth: it stays there, with
+        // zero variance, and its verdict says held.
+        let held_x = rear.laser.x + 0.005;
+        let mut options = SolveOptions::default();
+        let prior_sigma = sigma_b;
+        options.constraints.0[2] = Constraint::Prior {
+            mean: front.b,
+            sigma: prior_sigma,
+        };
+        let more = [[Constraint::Held(held_x), Constraint::Free, Constraint::Free]];
+        let cal = calibrate_lasers_constrained(&samples, &laser_of, &options, &more).unwrap();
+        assert_eq!(cal.params[6], held_x, "shared {shared}");
+        assert!(cal.covariance[6].iter().all(|v| *v == 0.0));
+        let view = cal.view(1);
+        assert_eq!(
+            view.observability.parameters[3].constraint,
+            Constraint::Held(held_x)
+        );
+        assert_eq!(
+            view.observability.parameters[3].verdict,
+            Verdict::WellDetermined
+        );
+        assert_eq!(cal.constraints[1].held(3), Some(held_x));
+        // The prior on b, in both lasers' own solves, counts once: with a prior as
+        // informative as the data, σ_b is about 1/√2 = 0.71 of the free one's
+        // (about 0.7 with independent samples, 0.75 through the lasers' own
+        // sandwich covariances); counted twice it would be 1/√3 = 0.58, never 1.
+        let ratio = cal.covariance[2][2].sqrt() / sigma_b;
+        assert!(
+            (0.65..0.8).contains(&ratio),
+            "shared {shared}: σ_b with the prior / without = {ratio}"
+        );
+        // The first laser's ℓ moves little; the held value is not the truth, so the
+        // rear laser's ℓy, ℓθ absorb part of it, but the wheels stay within 4σ.
+        for i in 0..3 {
+            let z = (cal.params[i] - free.params[i]) / free.covariance[i][i].sqrt();
+            assert!(z.abs() < 4.0, "shared {shared}: wheel {i} moved {z:.1}σ");
+        }
+    }
+}
+
+#[test]
+fn constraints_for_a_laser_without_samples_are_an_error() {
+    let (front, _) = two_lasers();
+    let samples = exact_samples(&mut rng(8), &front, 60, 1);
+    let laser_of = vec![0; samples.len()];
+    let more = [[Constraint::Held(0.1), Constraint::Free, Constraint::Free]];
+    let e = calibrate_lasers_constrained(&samples, &laser_of, &SolveOptions::default(), &more);
+    assert!(e.is_err());
+}
+
+/// One drive seen by both lasers over the same intervals (the worst case of two
+/// lasers' samples sharing odometry: every interval overlaps fully): each laser's ŝ
+/// is its true motion plus its own matching noise, and both lasers' samples carry the
+/// same wheel rotations, off the true ones by one encoder error per wheel and
+/// interval of standard deviation `encoder_sigma` (rad).
+fn drive_shared_wheels(
+    r: &mut StdRng,
+    lasers: &[Params],
+    n: usize,
+    encoder_sigma: f64,
+) -> (Vec<Sample>, Vec<usize>) {
+    use rand_distr::{Distribution, Normal};
+    let wheel = Normal::new(0.0, encoder_sigma).unwrap();
+    let truth = exact_samples(r, &lasers[0], n, 1);
+    let noisy: Vec<(f64, f64)> = truth
+        .iter()
+        .map(|s| (s.dphi_l + wheel.sample(r), s.dphi_r + wheel.sample(r)))
+        .collect();
+    let mut samples = Vec::new();
+    let mut laser_of = Vec::new();
+    for (k, p) in lasers.iter().enumerate() {
+        let pred = odocal_solver::Predictor::new(p, true);
+        let mut own: Vec<Sample> = truth
+            .iter()
+            .zip(&noisy)
+            .map(|(s, &(l, rr))| {
+                let sm = Pose2::from_array(pred.predict(s));
+                Sample::from_rotations(s.t, l, rr, sm)
+            })
+            .collect();
+        add_noise(r, &mut own, [0.002, 0.002, 0.004]);
+        laser_of.extend(std::iter::repeat_n(k, own.len()));
+        samples.extend(own);
+    }
+    (samples, laser_of)
+}
+
+/// Mean NEES of the 9 joint parameters over `runs` drives with encoder errors of
+/// `encoder_sigma` shared by the two lasers' samples.
+fn shared_wheels_nees(runs: usize, seed: u64, encoder_sigma: f64) -> f64 {
+    let (front, rear) = two_lasers();
+    let truth = truth_vector(&[front, rear]);
+    let mut r = rng(seed);
+    let mut sum = 0.0;
+    for _ in 0..runs {
+        let (samples, laser_of) = drive_shared_wheels(&mut r, &[front, rear], 150, encoder_sigma);
+        let cal = calibrate_lasers(&samples, &laser_of, &SolveOptions::default()).unwrap();
+        let err = joint_error(&cal.params, &truth);
+        sum += nees(&err, &DMatrix::from_fn(9, 9, |i, j| cal.covariance[i][j]));
+    }
+    sum / runs as f64
+}
+
+/// A realistic encoder error per wheel and interval: the difference of two readings
+/// of a 2764.8-tick encoder (Khepera III; each floored: σ = tick/√6) plus 2 ms of
+/// read-time jitter at 5 rad/s (uniform ±2 ms at each end: 5·0.002·√(2/3)).
+const REALISTIC_ENCODER_SIGMA: f64 = 0.000_928 + 0.008_2;
+
+/// The two lasers' samples share the wheel encoders' errors, which the joint model
+/// takes as independent: at a realistic encoder error (9 mrad per wheel and interval,
+/// i.e. 0.3 mm of wheel travel against 2 mm of matching noise) the joint NEES is
+/// still χ²(9). Fast version of the Monte Carlo below.
+#[test]
+fn shared_encoder_noise_leaves_the_joint_nees_consistent() {
+    let runs = 40;
+    let nees = shared_wheels_nees(runs, 11, REALISTIC_ENCODER_SIGMA);
+    let half9 = 3.5 * (18.0 / runs as f64).sqrt();
+    assert!((nees - 9.0).abs() < half9, "mean NEES {nees}");
+}
+
+#[test]
+#[ignore = "Monte Carlo, 300 runs per encoder error (about 1 s in release)"]
+fn shared_encoder_noise_monte_carlo() {
+    let runs = 300;
+    let half9 = 3.5 * (18.0 / runs as f64).sqrt();
+    let mut line = Vec::new();
+    for factor in [0.0, 1.0, 3.0, 10.0] {
+        let nees = shared_wheels_nees(runs, 12, factor * REALISTIC_ENCODER_SIGMA);
+        line.push(format!("{factor}x: {nees:.2}"));
+        if factor <= 1.0 {
+            assert!((nees - 9.0).abs() < half9, "{factor}x: mean NEES {nees}");
+        }
+    }
+    println!(
+        "mean NEES (9 expected) by encoder error: {}",
+        line.join(", ")
+    );
+    // Ten times the realistic error is visible: the test can tell.
+    let big = shared_wheels_nees(runs, 12, 10.0 * REALISTIC_ENCODER_SIGMA);
+    assert!(big > 9.0 + half9, "10x: mean NEES {big}");
 }
