@@ -27,7 +27,7 @@ const CHI2_3_997: f64 = 14.16;
 /// A result comfortably well conditioned (condition number below this share of
 /// [`IcpParams::max_condition_number`]) is not tested: its cost has a clear bowl in
 /// every direction (clean scans of rooms and arenas; keeps the matcher's time).
-const TESTED_CONDITION_SHARE: f64 = 0.1;
+const TESTED_CONDITION_SHARE: f64 = 0.2;
 
 /// Two converged runs differ by up to this many times the convergence epsilons.
 const CONVERGENCE_SPREAD: f64 = 3.0;
@@ -105,8 +105,7 @@ impl Matcher {
         for (k, t) in tolerance.iter().enumerate() {
             judged[k][k] += t * t;
         }
-        let mut widest = [0.0; 3];
-        let mut widest_q = 0.0;
+        // Both sides: a wall may stop the iterations on one.
         for sign in [1.0, -1.0] {
             let start = moved(&result.pose, result.weakest_direction, sign * step, rho);
             // A start from which the pair fails or is refused says nothing about the
@@ -119,17 +118,14 @@ impl Matcher {
                 again.pose.y - result.pose.y,
                 odocal_geom::wrap_angle(again.pose.theta - result.pose.theta),
             ];
-            let q = mahalanobis_sq(d, &judged);
-            if q > widest_q {
-                (widest, widest_q) = (d, q);
-            }
-        }
-        if widest_q > CHI2_3_997 {
-            result.ill_conditioned = true;
-            for (r, row) in result.covariance.iter_mut().enumerate() {
-                for (c, v) in row.iter_mut().enumerate() {
-                    *v += widest[r] * widest[c];
+            if mahalanobis_sq(d, &judged) > CHI2_3_997 {
+                result.ill_conditioned = true;
+                for (r, row) in result.covariance.iter_mut().enumerate() {
+                    for (c, v) in row.iter_mut().enumerate() {
+                        *v += d[r] * d[c];
+                    }
                 }
+                break;
             }
         }
         result
