@@ -21,9 +21,12 @@ const VISIBLE_TOLERANCE_M: f64 = 0.05;
 /// χ²(3)'s 99.7 % level: a right covariance leaves 0.3 % of the NEES above it.
 const NEES_997: f64 = 14.16;
 
+/// A covariance of `(x, y, θ)`.
+type Covariance = [[f64; 3]; 3];
+
 /// The squared Mahalanobis distance of `e` (x, y, θ) under `cov` (∞ when `cov` is
 /// singular or not finite).
-fn nees(e: [f64; 3], cov: &[[f64; 3]; 3]) -> f64 {
+fn nees(e: [f64; 3], cov: &Covariance) -> f64 {
     let m = nalgebra::Matrix3::from_fn(|r, c| cov[r][c]);
     let v = nalgebra::Vector3::from(e);
     match m.try_inverse() {
@@ -210,7 +213,7 @@ fn measure_in(config: SimConfig, world: &World) -> Yield {
             scans[i].sensor
         }
     };
-    let matched: BTreeMap<(usize, usize), (Pose2, [[f64; 3]; 3])> = synced
+    let matched: BTreeMap<(usize, usize), (Pose2, Covariance)> = synced
         .samples
         .iter()
         .map(|s| {
