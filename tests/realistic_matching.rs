@@ -18,6 +18,22 @@ const MAX_ERROR_RAD: f64 = 0.5 * std::f64::consts::PI / 180.0;
 /// A scan point of the second scan counts as seen by the first when the first's ray
 /// toward it reaches it within this (m).
 const VISIBLE_TOLERANCE_M: f64 = 0.05;
+/// χ²(3)'s 99.7 % level: a right covariance leaves 0.3 % of the NEES above it.
+const NEES_997: f64 = 14.16;
+
+/// A covariance of `(x, y, θ)`.
+type Covariance = [[f64; 3]; 3];
+
+/// The squared Mahalanobis distance of `e` (x, y, θ) under `cov` (∞ when `cov` is
+/// singular or not finite).
+fn nees(e: [f64; 3], cov: &Covariance) -> f64 {
+    let m = nalgebra::Matrix3::from_fn(|r, c| cov[r][c]);
+    let v = nalgebra::Vector3::from(e);
+    match m.try_inverse() {
+        Some(inv) if inv.iter().all(|x| x.is_finite()) => (v.transpose() * inv * v)[0],
+        _ => f64::INFINITY,
+    }
+}
 
 /// What the matcher did on one log.
 #[derive(Debug, Default, Clone)]
@@ -30,6 +46,9 @@ struct Yield {
     overlapping_matched: usize,
     /// All accepted matches, and their errors against the truth (m, rad).
     errors: Vec<(f64, f64)>,
+    /// Per accepted match (same order): its NEES, the error's squared Mahalanobis
+    /// distance under the match's own covariance (χ²(3) when the covariance is right).
+    nees: Vec<f64>,
     /// The matcher's rejections, by reason.
     rejections: BTreeMap<&'static str, usize>,
 }
@@ -40,6 +59,7 @@ impl Yield {
         self.overlapping += other.overlapping;
         self.overlapping_matched += other.overlapping_matched;
         self.errors.extend_from_slice(&other.errors);
+        self.nees.extend_from_slice(&other.nees);
         for (k, v) in &other.rejections {
             *self.rejections.entry(k).or_default() += v;
         }
@@ -56,6 +76,27 @@ impl Yield {
             .iter()
             .filter(|(d, a)| *d > MAX_ERROR_M || *a > MAX_ERROR_RAD)
             .count()
+    }
+
+    /// Accepted matches beyond 5 mm or 0.5° of the truth whose own covariance does not
+    /// cover the error (NEES beyond χ²(3)'s 99.7 % level): confidently wrong.
+    fn wrong_uncovered(&self) -> usize {
+        self.errors
+            .iter()
+            .zip(&self.nees)
+            .filter(|((d, a), n)| (*d > MAX_ERROR_M || *a > MAX_ERROR_RAD) && **n > NEES_997)
+            .count()
+    }
+
+    /// Mean NEES of the accepted matches (3 when their covariances are right).
+    fn mean_nees(&self) -> f64 {
+        self.nees.iter().sum::<f64>() / self.nees.len().max(1) as f64
+    }
+
+    /// Share of the accepted matches whose NEES is beyond χ²(3)'s 99.7 % level
+    /// (0.003 when their covariances are right).
+    fn nees_beyond(&self) -> f64 {
+        self.nees.iter().filter(|n| **n > NEES_997).count() as f64 / self.nees.len().max(1) as f64
     }
 
     /// RMS translation (mm) and rotation (°) error of the accepted matches.
@@ -83,7 +124,7 @@ impl Yield {
             .map(|(k, n)| format!("{k} {n}"))
             .collect();
         format!(
-            "| {label} | {} | {} | {}/{} ({:.0} %) | {} | {rd:.1} mm / {ra:.2}° | {wd:.1} mm / {wa:.2}° | {} ({:.0} %) | {} |",
+            "| {label} | {} | {} | {}/{} ({:.0} %) | {} | {rd:.1} mm / {ra:.2}° | {wd:.1} mm / {wa:.2}° | {} ({:.0} %) | {} | {:.1}, {:.1} % | {} |",
             self.tried,
             self.overlapping,
             self.overlapping_matched,
@@ -92,12 +133,15 @@ impl Yield {
             self.errors.len(),
             self.wrong(),
             100.0 * self.wrong() as f64 / self.errors.len().max(1) as f64,
+            self.wrong_uncovered(),
+            self.mean_nees(),
+            100.0 * self.nees_beyond(),
             reasons.join(", ")
         )
     }
 }
 
-const TABLE_HEADER: &str = "| preset, seeds | pairs tried | true overlap ≥ ½ | matched of those | accepted | RMS error | worst error | beyond 5 mm / 0.5° | rejections |\n|---|---|---|---|---|---|---|---|---|";
+const TABLE_HEADER: &str = "| preset, seeds | pairs tried | true overlap ≥ ½ | matched of those | accepted | RMS error | worst error | beyond 5 mm / 0.5° | of those, NEES > 14.2 | NEES: mean, share > 14.2 | rejections |\n|---|---|---|---|---|---|---|---|---|---|---|";
 
 /// The share of the returns of `second` (taken from `p2`) that the sensor at `p1` sees
 /// too: the ray from `p1` toward each point reaches it (nothing nearer in between,
@@ -169,10 +213,15 @@ fn measure_in(config: SimConfig, world: &World) -> Yield {
             scans[i].sensor
         }
     };
-    let matched: BTreeMap<(usize, usize), Pose2> = synced
+    let matched: BTreeMap<(usize, usize), (Pose2, Covariance)> = synced
         .samples
         .iter()
-        .map(|s| ((s.pair.first, s.pair.second), s.icp.pose))
+        .map(|s| {
+            (
+                (s.pair.first, s.pair.second),
+                (s.icp.pose, s.icp.covariance),
+            )
+        })
         .collect();
     let discarded_other = synced.discarded.0.values().sum::<usize>()
         - synced.discarded.0.get("match_failed").copied().unwrap_or(0);
@@ -194,11 +243,19 @@ fn measure_in(config: SimConfig, world: &World) -> Yield {
                 y.overlapping_matched += 1;
             }
         }
-        if let Some(pose) = accepted {
+        if let Some((pose, cov)) = accepted {
             let truth = a.inverse().compose(&b);
             let e = truth.inverse().compose(pose);
             y.errors
                 .push((e.x.hypot(e.y), odocal_geom::wrap_angle(e.theta).abs()));
+            // The error in the parameters the covariance is of: ŝ's (x, y, θ) in the
+            // first scan's frame.
+            let d = [
+                pose.x - truth.x,
+                pose.y - truth.y,
+                odocal_geom::wrap_angle(pose.theta - truth.theta),
+            ];
+            y.nees.push(nees(d, cov));
         }
         i += k;
     }
@@ -241,11 +298,12 @@ fn check(preset: &str, min_share: f64) {
     );
 }
 
-// Today's matcher (main at 4d58c6a) accepts matches beyond 5 mm / 0.5° of the truth on
-// mines-rover and turtlebot4-rplidar (15 of 28 and 16 of 33 accepted matches on these
-// 20 s logs; the table in docs/benchmarks.md), so their tests fail on the last
-// assertion and are ignored until the matcher work (issue 20 item 2) lands. The
-// shares asserted are today's (61 %, 66 %) less a margin.
+// Today's matcher accepts matches beyond 5 mm / 0.5° of the truth on mines-rover and
+// turtlebot4-rplidar (on these 20 s logs 28 of 43 and 10 of 28 after the basin test;
+// most of the rover's within their own covariance: the tables in docs/benchmarks.md),
+// so their tests fail on the last assertion and stay ignored until the matcher's
+// accuracy (issue 20 item 2) improves. The shares asserted are main at 4d58c6a's
+// (61 %, 66 %) less a margin.
 
 #[test]
 #[ignore = "today's matcher accepts matches beyond 5 mm / 0.5° here (docs/benchmarks.md)"]
@@ -285,6 +343,73 @@ fn measurement_finds_the_clean_presets_clean() {
         assert_eq!(y.wrong(), 0, "{preset}: {:?}", y.worst());
         assert!(y.rms().0 < 2.5, "{preset}: {:?}", y.rms());
     }
+}
+
+/// A pair whose cost is flat along the robot's motion is not called determined: on the
+/// TurtleBot 4's laser (σ = 3 mm + 0.5 %·r) in the cluttered office (no people, no
+/// sweep, no other realism), scans 72 and 75 matched from identity stopped 108 mm
+/// short of the truth with a reported σ of 2.7 mm along it (NEES ≈ 1,700; started
+/// 30 mm either side of the truth, the iterations stay 30 mm off). The match must be
+/// refused, flagged ill-conditioned, or carry a covariance that covers its error.
+#[test]
+fn a_flat_cost_is_not_called_determined() {
+    let mut config = SimConfig::preset("turtlebot4-rplidar").unwrap();
+    config.duration = 10.0;
+    config.laser.time_increment = 0.0;
+    let r = config.laser.realism.as_mut().unwrap();
+    (r.half_return_range, r.grazing_angle) = (1e3, 1.5);
+    (r.bias_offset, r.bias_quadratic, r.drift) = (0.0, 0.0, 0.0);
+    r.mixed_pixel_probability = 0.0;
+    let world = World::preset(&config.world).unwrap().with_walkers(vec![]);
+    let run = simulate_in(&config, &world).unwrap();
+    let scans: Vec<_> = run.logged_scans().collect();
+    let angles = run.config.laser.angles();
+    let params = odocal_icp::IcpParams {
+        typical_noise_sigma: 0.005,
+        ..odocal_icp::IcpParams::default()
+    };
+    let prepare = |i: usize| {
+        odocal_icp::PreparedScan::new(
+            &scans[i].ranges,
+            &angles,
+            config.laser.min_range,
+            config.laser.max_range,
+            &params,
+        )
+        .unwrap()
+    };
+    let (a, b) = (72, 75);
+    let truth = scans[a].sensor.inverse().compose(&scans[b].sensor);
+    assert!(truth.x > 0.08, "the robot drives forward here: {truth}");
+    let mut matcher = odocal_icp::Matcher::new(params.clone());
+    let Ok(r) = matcher.match_scans(&prepare(a), &prepare(b), Pose2::IDENTITY) else {
+        return;
+    };
+    let d = [
+        r.pose.x - truth.x,
+        r.pose.y - truth.y,
+        odocal_geom::wrap_angle(r.pose.theta - truth.theta),
+    ];
+    let q = nees(d, &r.covariance);
+    assert!(
+        r.ill_conditioned || q <= NEES_997,
+        "accepted {} against the truth {truth}, σx {:.1} mm, NEES {q:.0}",
+        r.pose,
+        r.covariance[0][0].sqrt() * 1e3
+    );
+}
+
+/// The accepted matches' covariances on the TurtleBot 4 preset (20 s): before the
+/// sandwich covariance and the basin test, their NEES averaged 51 (3 when right) and
+/// 52 % were beyond χ²(3)'s 99.7 % level; now 17 and 29 %. Not yet consistent (see
+/// docs/benchmarks.md): the bound guards what was gained.
+#[test]
+fn turtlebot4_covariances_cover_most_errors() {
+    let y = measure("turtlebot4-rplidar", 1, 20.0);
+    println!("{TABLE_HEADER}\n{}", y.row("turtlebot4-rplidar"));
+    assert!(y.nees.len() >= 10, "{} accepted", y.nees.len());
+    assert!(y.mean_nees() < 30.0, "mean NEES {:.1}", y.mean_nees());
+    assert!(y.nees_beyond() < 0.4, "{:.2} beyond", y.nees_beyond());
 }
 
 /// The table of docs/benchmarks.md: 120 s of each realistic preset, three seeds.

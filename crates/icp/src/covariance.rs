@@ -1,4 +1,4 @@
-//! Uncertainty of the result: Hessian-based covariance scaled by the residual noise.
+//! Uncertainty of the result: a sandwich covariance with the residual noise by range.
 //!
 //! At the solution, each used correspondence contributes the row
 //! `J_i = [n_x, n_y, n_iᵀ R'(θ) q_i]` (derivative of its residual with respect to
@@ -8,6 +8,14 @@
 //! first-order covariance is `σ̂² I⁻¹`, `σ̂² = Σ w_i e_i² / (m − 3)` — the estimate
 //! for independent residuals (it does not propagate the noise of the reference points
 //! through the local lines, as Censi's ICRA 2007 closed form does).
+//!
+//! That single σ̂ is the noise of the bulk of the points, the near ones; on lasers
+//! whose noise grows with the range, a displacement only far points determine came
+//! out many times too certain. So the covariance is the sandwich `I⁻¹ S I⁻¹`,
+//! `S = Σ w_i v_i J_iᵀ J_i`, `v_i` the robust residual variance of the correspondences
+//! at about the range of point `i` (module `range_noise`), times `m / (m − 3)`; with
+//! equal noise at every range it is the `σ̂² I⁻¹` above (σ̂ median-based). A singular
+//! information matrix keeps `σ̂² I⁻¹` (infinite along the singular direction).
 //!
 //! Residuals of neighbouring rays are not independent: the range noise of a real
 //! sensor is correlated over a few rays, and neighbouring matches share the local
@@ -140,6 +148,9 @@ pub(crate) struct InformationSum<'a> {
     cos: f64,
     /// Upper triangle of `Σ w JᵀJ`: (0,0), (0,1), (0,2), (1,1), (1,2), (2,2).
     info: [f64; 6],
+    /// Upper triangle of `Σ w v JᵀJ` (`v`: the variance of the weighted residual
+    /// `√w·e`), the expected scatter of the score `Σ w e J` (same order).
+    score: [f64; 6],
     sum_sq: f64,
     sum_r2: f64,
     count: usize,
@@ -161,6 +172,7 @@ impl<'a> InformationSum<'a> {
             sin,
             cos,
             info: [0.0; 6],
+            score: [0.0; 6],
             sum_sq: 0.0,
             sum_r2: 0.0,
             count: 0,
@@ -170,8 +182,17 @@ impl<'a> InformationSum<'a> {
 
     /// Adds a used correspondence: current point `q` of ray `ray` (each ray at most
     /// once), reference line normal, residual and weight (inverse residual variance up
-    /// to the common factor σ̂²).
-    pub fn add(&mut self, ray: usize, q: [f64; 2], normal: [f64; 2], residual: f64, w: f64) {
+    /// to the common factor σ̂²), and `noise_variance`, the variance of its weighted
+    /// residual `√w·e` (from the residuals at its range: module `range_noise`).
+    pub fn add(
+        &mut self,
+        ray: usize,
+        q: [f64; 2],
+        normal: [f64; 2],
+        residual: f64,
+        w: f64,
+        noise_variance: f64,
+    ) {
         if let (Some(r), Some(p)) = (
             self.rays.residual.get_mut(ray),
             self.rays.present.get_mut(ray / 64),
@@ -190,6 +211,15 @@ impl<'a> InformationSum<'a> {
         info[3] += wj[1] * j[1];
         info[4] += wj[1] * j[2];
         info[5] += wj[2] * j[2];
+        // E[(w e J)(w e J)ᵀ] = w · noise_variance · JJᵀ.
+        let v = noise_variance;
+        let score = &mut self.score;
+        score[0] += v * wj[0] * j[0];
+        score[1] += v * wj[0] * j[1];
+        score[2] += v * wj[0] * j[2];
+        score[3] += v * wj[1] * j[1];
+        score[4] += v * wj[1] * j[2];
+        score[5] += v * wj[2] * j[2];
         self.sum_sq += w * residual * residual;
         self.sum_r2 += q[0] * q[0] + q[1] * q[1];
         self.count += 1;
@@ -225,6 +255,31 @@ impl<'a> InformationSum<'a> {
         factor
     }
 
+    /// The sandwich covariance `I⁻¹ S I⁻¹` in the scaled axes (`D I D = V Λ Vᵀ`, every
+    /// eigenvalue positive), `S = Σ w v JᵀJ` the scatter of the score, with the small
+    /// sample factor `m / (m − 3)` and the residual correlation `inflation`.
+    fn sandwich(
+        &self,
+        eig: &SymmetricEigen<f64, U3>,
+        d: [f64; 3],
+        m: usize,
+        inflation: f64,
+    ) -> Matrix3<f64> {
+        let t = &self.score;
+        let score = Matrix3::new(t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5]);
+        let scaled = Matrix3::from_fn(|r, c| d[r] * score[(r, c)] * d[c]);
+        let v = &eig.eigenvectors;
+        // I⁻¹ S I⁻¹ in the eigenbasis: (Vᵀ S V)_kl / (λ_k λ_l).
+        let mut in_basis = v.transpose() * scaled * v;
+        for k in 0..3 {
+            for l in 0..3 {
+                in_basis[(k, l)] /= eig.eigenvalues[k] * eig.eigenvalues[l];
+            }
+        }
+        let factor = m as f64 / (m.saturating_sub(3).max(1)) as f64 * inflation;
+        v * in_basis * v.transpose() * factor
+    }
+
     /// Covariance and conditioning; `None` when the sums are not finite.
     pub fn finish(&self) -> Option<Uncertainty> {
         let m = self.count;
@@ -236,22 +291,27 @@ impl<'a> InformationSum<'a> {
         let info = Matrix3::new(t[0], t[1], t[2], t[1], t[3], t[4], t[2], t[4], t[5]);
         let (eig, cond) = scaled_eigen(&info, rho)?;
         let d = [1.0, 1.0, 1.0 / rho];
-        // Covariance: σ̂² I⁻¹ = σ̂² D (DID)⁻¹ D, inverted in the eigenbasis so that a
-        // singular direction gives an infinite (not NaN) variance along it.
-        let mut cov = Matrix3::<f64>::zeros();
-        for k in 0..3 {
-            let l = eig.eigenvalues[k];
-            let inv = if l > 0.0 { 1.0 / l } else { f64::INFINITY };
-            let v = eig.eigenvectors.column(k);
-            for r in 0..3 {
-                for c in 0..3 {
-                    let vv = v[r] * v[c];
-                    if vv != 0.0 {
-                        cov[(r, c)] += sigma2 * inv * vv;
+        let cov = if eig.eigenvalues.iter().all(|&l| l > 0.0) {
+            self.sandwich(&eig, d, m, inflation)
+        } else {
+            // Covariance: σ̂² I⁻¹ = σ̂² D (DID)⁻¹ D, inverted in the eigenbasis so that
+            // a singular direction gives an infinite (not NaN) variance along it.
+            let mut cov = Matrix3::<f64>::zeros();
+            for k in 0..3 {
+                let l = eig.eigenvalues[k];
+                let inv = if l > 0.0 { 1.0 / l } else { f64::INFINITY };
+                let v = eig.eigenvectors.column(k);
+                for r in 0..3 {
+                    for c in 0..3 {
+                        let vv = v[r] * v[c];
+                        if vv != 0.0 {
+                            cov[(r, c)] += sigma2 * inv * vv;
+                        }
                     }
                 }
             }
-        }
+            cov
+        };
         // D·cov·D element-wise (D is diagonal; avoids 0·∞).
         let mut covariance = [[0.0; 3]; 3];
         for (r, row) in covariance.iter_mut().enumerate() {

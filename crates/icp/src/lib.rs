@@ -39,7 +39,12 @@
 //! 7. `consistency`: a result whose residual spread is far above the range noise the
 //!    two scans show themselves, or that uses too few of the current scan's points,
 //!    is a wrong local minimum and is refused.
-//! 8. `rotation_search`: when the attempt from the first guess fails or is refused,
+//! 8. `basin_check`: a result that is not comfortably well conditioned is matched
+//!    again from a step away along its least constrained direction; when the
+//!    iterations do not come back (the cost is flat there whatever its curvature with
+//!    the correspondences fixed says), it is flagged `ill_conditioned` and its
+//!    covariance widened.
+//! 9. `rotation_search`: when the attempt from the first guess fails or is refused,
 //!    the matcher starts again from the rotations where the two scans' histograms of
 //!    line directions agree best (translation-independent); two distinct consistent
 //!    results are refused as ambiguous.
@@ -58,6 +63,7 @@
 
 #![deny(missing_docs)]
 
+mod basin_check;
 mod consistency;
 mod correspondence;
 mod covariance;
@@ -65,6 +71,7 @@ mod error;
 mod matcher;
 mod params;
 mod preprocess;
+mod range_noise;
 mod rotation_search;
 mod solve_step;
 mod trimming;

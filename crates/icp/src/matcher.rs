@@ -3,6 +3,7 @@
 use crate::consistency::{check_consistency, robust_spread, scans_noise};
 use crate::correspondence::{nearest_by_angle, nearest_by_tree, segment_for};
 use crate::covariance::{conditioning, InformationSum, RayResiduals};
+use crate::range_noise::RangeBins;
 use crate::rotation_search::candidate_rotations;
 use crate::solve_step::NormalEquations;
 use crate::trimming::threshold;
@@ -124,6 +125,8 @@ pub struct Matcher {
     weight_cache: Vec<(u32, f64)>,
     /// Scratch of the covariance's residual autocorrelation.
     ray_residuals: RayResiduals,
+    /// Scratch of the covariance's residual noise by range.
+    range_bins: RangeBins,
 }
 
 impl Matcher {
@@ -136,6 +139,7 @@ impl Matcher {
             search_start: Vec::new(),
             weight_cache: Vec::new(),
             ray_residuals: RayResiduals::default(),
+            range_bins: RangeBins::default(),
         }
     }
 
@@ -181,7 +185,16 @@ impl Matcher {
             &params,
             use_tree,
         ) {
-            Ok(result) => return Ok(result),
+            Ok(result) => {
+                return Ok(self.basin_checked(
+                    reference,
+                    current,
+                    result,
+                    first_guess,
+                    &params,
+                    use_tree,
+                ))
+            }
             Err(e) => e,
         };
         let candidates = candidate_rotations(
@@ -224,14 +237,18 @@ impl Matcher {
             };
         }
         match found {
-            Some(result) => Ok(IcpResult { starts, ..result }),
+            Some(result) => {
+                let result =
+                    self.basin_checked(reference, current, result, first_guess, &params, use_tree);
+                Ok(IcpResult { starts, ..result })
+            }
             None => Err(first_error),
         }
     }
 
     /// The ICP iterations from `start`, the corrections measured from `anchor` (the
     /// caller's first guess), and the consistency test of the result.
-    fn refine(
+    pub(crate) fn refine(
         &mut self,
         reference: &PreparedScan,
         current: &PreparedScan,
@@ -469,16 +486,25 @@ impl Matcher {
         let (s, c) = estimate.theta.sin_cos();
         let mut sum_abs = 0.0;
         self.squared_residuals.clear();
-        for k in &self.correspondences {
+        self.range_bins.clear();
+        let residual = |k: &Correspondence| {
             let p = [
                 estimate.x + c * k.q[0] - s * k.q[1],
                 estimate.y + s * k.q[0] + c * k.q[1],
             ];
-            let e = k.normal[0] * p[0] + k.normal[1] * p[1] - k.offset;
+            k.normal[0] * p[0] + k.normal[1] * p[1] - k.offset
+        };
+        for k in &self.correspondences {
+            let e = residual(k);
             self.squared_residuals.push(e * e * k.weight);
+            self.range_bins.push(k.q[0].hypot(k.q[1]), e * e * k.weight);
+        }
+        let noise_variances = self.range_bins.variances();
+        for (k, &v) in self.correspondences.iter().zip(noise_variances) {
             if k.normalized_sq > tau_sq {
                 continue;
             }
+            let e = residual(k);
             sum_abs += e.abs();
             info.add(
                 current.valid_indices[(k.key >> 32) as usize] as usize,
@@ -486,6 +512,7 @@ impl Matcher {
                 k.normal,
                 e,
                 k.weight,
+                v,
             );
         }
         let used = info.count();
