@@ -55,7 +55,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if std::env::var("NOISE").is_ok() {
         print_noise(&log)?;
     }
-    let (pairs, guesses, results, store) = match_log(&log, stride, offset, &params, &icp_params()?);
+    let Matched {
+        pairs,
+        guesses,
+        results,
+        store,
+    } = match_log(&log, stride, offset, &params, &icp_params()?);
     tally(&results);
     if let Ok(first) = std::env::var("PLOT") {
         let first: usize = first.parse()?;
@@ -112,20 +117,18 @@ fn icp_params() -> Result<IcpParams, Box<dyn std::error::Error>> {
     Ok(icp)
 }
 
+/// The pairs of a log, their guesses, the matcher's outcomes, and the
+/// (sweep-compensated) scans matched.
+struct Matched {
+    pairs: Vec<(usize, usize)>,
+    guesses: Vec<Pose2>,
+    results: Vec<Outcome>,
+    store: odocal_log::ScanStore,
+}
+
 /// Every pair `stride` scans apart with wheel readings around both scans: the pairs,
 /// their odometry guesses, and the matcher's outcomes.
-fn match_log(
-    log: &Log,
-    stride: usize,
-    offset: f64,
-    params: &Params,
-    icp: &IcpParams,
-) -> (
-    Vec<(usize, usize)>,
-    Vec<Pose2>,
-    Vec<Outcome>,
-    odocal_log::ScanStore,
-) {
+fn match_log(log: &Log, stride: usize, offset: f64, params: &Params, icp: &IcpParams) -> Matched {
     let ticks = log
         .params
         .ticks_per_revolution
@@ -164,7 +167,12 @@ fn match_log(
     }
     let (store, _) = compensated_pairs(&log.scans, &pairs, &track, &limits, params, offset);
     let results = match_pairs(&store, &pairs, &guesses, icp, || {});
-    (pairs, guesses, results, store)
+    Matched {
+        pairs,
+        guesses,
+        results,
+        store,
+    }
 }
 
 /// The scans' own range noise (distribution over the log).
@@ -281,13 +289,18 @@ fn preset_mode(
         print_noise(&log)?;
     }
     let icp = icp_params()?;
-    let (pairs, guesses, results, _) = match_log(&log, stride, 0.0, &params, &icp);
+    let Matched {
+        pairs,
+        guesses,
+        results,
+        ..
+    } = match_log(&log, stride, 0.0, &params, &icp);
     let relaxed_icp = IcpParams {
         max_residual_to_noise: f64::INFINITY,
         min_matched_share: 0.0,
         ..icp.clone()
     };
-    let (_, _, relaxed, _) = match_log(&log, stride, 0.0, &params, &relaxed_icp);
+    let relaxed = match_log(&log, stride, 0.0, &params, &relaxed_icp).results;
     let truth: Vec<Pose2> = pairs
         .iter()
         .map(|&(i, j)| truth_scans[i].inverse().compose(&truth_scans[j]))
