@@ -156,7 +156,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let t_parse = Instant::now();
     let files = input.paths();
     check_own_laser(&args.own_laser, files.len())?;
-    let inputs = input.read_lasers()?;
+    // On the pool's threads: the reader parses scan readings ahead on them.
+    let inputs = pool.install(|| input.read_lasers())?;
     let parse_s = t_parse.elapsed().as_secs_f64();
     // One entry per laser's log: a bag read for several scan topics is one per topic.
     let several_topics = input.read.scan_topic.len() > 1;
