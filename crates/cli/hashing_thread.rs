@@ -1,41 +1,60 @@
-//! The SHA-256 of a text log computed on another thread while the log is parsed. The
-//! input is read once, in chunks that the parser and the hashing thread share (not
-//! copied), so hashing (≈ 0.5 ms per MB here) is off the parse's critical path; the
-//! checksum is the one [`Sha256Reader`] gives for the same bytes.
+//! A text log read, and its SHA-256 computed, on another thread while the log is
+//! parsed: that thread reads the input in chunks through a [`Sha256Reader`] and hands
+//! them over (moved, not copied) to the parser, so neither the system's copy of the
+//! file's bytes nor hashing (≈ 0.5 ms per MB here) is on the parse's critical path. The
+//! checksum is [`Sha256Reader`]'s for the same bytes.
 
 use odocal_report::provenance::Sha256Reader;
 use std::io::{self, BufRead, Read};
-use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
-use std::sync::Arc;
+use std::sync::mpsc::{sync_channel, Receiver};
 use std::thread::JoinHandle;
 
 /// Bytes read from the input at a time.
 const CHUNK_BYTES: u64 = 1 << 18;
-/// Chunks read ahead of the hashing thread at most (bounded memory: 4 MB).
+/// Chunks read ahead of the parser at most (bounded memory: 4 MB).
 const CHUNKS_AHEAD: usize = 16;
 
-/// A buffered reader of `inner` whose bytes are hashed on another thread.
-pub struct HashedInput<R> {
-    inner: R,
-    chunk: Arc<Vec<u8>>,
+/// A buffered reader of an input that another thread reads and hashes.
+pub struct HashedInput {
+    chunks: Receiver<io::Result<Vec<u8>>>,
+    chunk: Vec<u8>,
     pos: usize,
-    to_hasher: Option<SyncSender<Arc<Vec<u8>>>>,
-    hasher: Option<JoinHandle<io::Result<(String, u64)>>>,
+    reader: Option<JoinHandle<io::Result<(String, u64)>>>,
 }
 
-impl<R: Read> HashedInput<R> {
-    /// Wraps `inner` and starts the hashing thread.
-    pub fn new(inner: R) -> io::Result<Self> {
-        let (to_hasher, chunks) = sync_channel(CHUNKS_AHEAD);
-        let hasher = std::thread::Builder::new()
-            .name("sha256".into())
-            .spawn(move || Sha256Reader::new(Chunks::new(chunks)).finish())?;
+impl HashedInput {
+    /// Starts the thread that reads and hashes `inner`.
+    pub fn new<R: Read + Send + 'static>(inner: R) -> io::Result<Self> {
+        let (to_parser, chunks) = sync_channel(CHUNKS_AHEAD);
+        let reader = std::thread::Builder::new()
+            .name("read-sha256".into())
+            .spawn(move || {
+                let mut hashing = Sha256Reader::new(inner);
+                loop {
+                    let mut chunk = Vec::with_capacity(CHUNK_BYTES as usize);
+                    match (&mut hashing).take(CHUNK_BYTES).read_to_end(&mut chunk) {
+                        Ok(0) => break,
+                        Ok(_) => {
+                            if to_parser.send(Ok(chunk)).is_err() {
+                                // The parser stopped (an error): the rest is not read.
+                                return Err(io::Error::other("the input was not read to its end"));
+                            }
+                        }
+                        Err(e) => {
+                            let again = io::Error::new(e.kind(), e.to_string());
+                            let _ = to_parser.send(Err(e));
+                            return Err(again);
+                        }
+                    }
+                }
+                drop(to_parser);
+                hashing.finish()
+            })?;
         Ok(HashedInput {
-            inner,
-            chunk: Arc::new(Vec::new()),
+            chunks,
+            chunk: Vec::new(),
             pos: 0,
-            to_hasher: Some(to_hasher),
-            hasher: Some(hasher),
+            reader: Some(reader),
         })
     }
 
@@ -49,27 +68,22 @@ impl<R: Read> HashedInput<R> {
             }
             self.consume(n);
         }
-        drop(self.to_hasher.take());
-        match self.hasher.take().map(JoinHandle::join) {
+        match self.reader.take().map(JoinHandle::join) {
             Some(Ok(result)) => result,
-            _ => Err(io::Error::other("the checksum thread stopped")),
+            _ => Err(io::Error::other("the input's reading thread stopped")),
         }
     }
 }
 
-impl<R: Read> BufRead for HashedInput<R> {
+impl BufRead for HashedInput {
     fn fill_buf(&mut self) -> io::Result<&[u8]> {
         if self.pos >= self.chunk.len() {
-            let mut next = Vec::with_capacity(CHUNK_BYTES as usize);
-            (&mut self.inner).take(CHUNK_BYTES).read_to_end(&mut next)?;
-            self.chunk = Arc::new(next);
             self.pos = 0;
-            if !self.chunk.is_empty() {
-                if let Some(tx) = &self.to_hasher {
-                    // A hashing thread that stopped is reported by `finish`.
-                    let _ = tx.send(Arc::clone(&self.chunk));
-                }
-            }
+            self.chunk = match self.chunks.recv() {
+                Ok(chunk) => chunk?,
+                // The end of the input (or of the reading thread, reported by finish).
+                Err(_) => Vec::new(),
+            };
         }
         Ok(&self.chunk[self.pos..])
     }
@@ -79,7 +93,7 @@ impl<R: Read> BufRead for HashedInput<R> {
     }
 }
 
-impl<R: Read> Read for HashedInput<R> {
+impl Read for HashedInput {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
         let available = self.fill_buf()?;
         let n = available.len().min(buf.len());
@@ -89,57 +103,22 @@ impl<R: Read> Read for HashedInput<R> {
     }
 }
 
-/// The chunks received by the hashing thread, read as one stream (it ends when the
-/// reader is finished or dropped).
-struct Chunks {
-    from_reader: Receiver<Arc<Vec<u8>>>,
-    chunk: Arc<Vec<u8>>,
-    pos: usize,
-}
-
-impl Chunks {
-    fn new(from_reader: Receiver<Arc<Vec<u8>>>) -> Self {
-        Chunks {
-            from_reader,
-            chunk: Arc::new(Vec::new()),
-            pos: 0,
-        }
-    }
-}
-
-impl Read for Chunks {
-    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        while self.pos >= self.chunk.len() {
-            match self.from_reader.recv() {
-                Ok(chunk) => {
-                    self.chunk = chunk;
-                    self.pos = 0;
-                }
-                Err(_) => return Ok(0),
-            }
-        }
-        let n = (self.chunk.len() - self.pos).min(buf.len());
-        buf[..n].copy_from_slice(&self.chunk[self.pos..self.pos + n]);
-        self.pos += n;
-        Ok(n)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     /// A reader that gives at most `step` bytes per read, as a pipe may.
-    struct Trickle<'a> {
-        bytes: &'a [u8],
+    struct Trickle {
+        bytes: Vec<u8>,
+        at: usize,
         step: usize,
     }
 
-    impl Read for Trickle<'_> {
+    impl Read for Trickle {
         fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-            let n = self.step.min(buf.len()).min(self.bytes.len());
-            buf[..n].copy_from_slice(&self.bytes[..n]);
-            self.bytes = &self.bytes[n..];
+            let n = self.step.min(buf.len()).min(self.bytes.len() - self.at);
+            buf[..n].copy_from_slice(&self.bytes[self.at..self.at + n]);
+            self.at += n;
             Ok(n)
         }
     }
@@ -150,7 +129,8 @@ mod tests {
         let expected = Sha256Reader::new(&bytes[..]).finish().unwrap();
         for step in [1 << 20, 4099] {
             let mut input = HashedInput::new(Trickle {
-                bytes: &bytes,
+                bytes: bytes.clone(),
+                at: 0,
                 step,
             })
             .unwrap();
@@ -167,7 +147,7 @@ mod tests {
             assert_eq!(more, bytes[upto..upto + 600_000]);
             assert_eq!(input.finish().unwrap(), expected);
         }
-        let empty = HashedInput::new(&b""[..]).unwrap().finish().unwrap();
+        let empty = HashedInput::new(io::empty()).unwrap().finish().unwrap();
         assert_eq!(empty, Sha256Reader::new(&b""[..]).finish().unwrap());
     }
 

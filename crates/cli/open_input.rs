@@ -1,7 +1,7 @@
 //! Opening the input: a ROS bag is read by path (its readers seek), a Carmen or JSON
 //! log is read once from start to end, so it may come through a pipe, a FIFO, process
 //! substitution (`<(zcat run.log.gz)`) or standard input (`-`), and its checksum is
-//! computed on the same pass (on another thread: [`HashedInput`]).
+//! computed on the same pass (read and hashed on another thread: [`HashedInput`]).
 
 use crate::hashing_thread::HashedInput;
 use anyhow::Context;
@@ -50,8 +50,8 @@ pub fn is_bag_file(path: &Path) -> anyhow::Result<bool> {
 /// with the SHA-256 and size of the input.
 pub fn read_text_log(path: &Path, opts: &ReadOptions) -> anyhow::Result<(Log, (String, u64))> {
     let name = input_name(path);
-    let source: Box<dyn Read> = if is_stdin(path) {
-        Box::new(io::stdin().lock())
+    let source: Box<dyn Read + Send> = if is_stdin(path) {
+        Box::new(io::stdin())
     } else {
         Box::new(File::open(path).map_err(|e| LogError::io(&name, e))?)
     };

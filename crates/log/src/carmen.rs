@@ -11,7 +11,7 @@ use crate::line_reader::{Line, MAX_LINE_BYTES};
 use crate::model::{LaserFields, Log, OdomRecord, ScanGeometry, ScanKind, ValueSource};
 use crate::options::{is_valid_modulus, ReadOptions};
 use crate::printable::printable;
-use crate::range_prescan::{prescan, Ready};
+use crate::range_prescan::{prescan, Prescan, Ready};
 use crate::tokens::{FieldError, Fields, Tokens};
 use odocal_geom::Pose2;
 use std::io::BufRead;
@@ -97,45 +97,37 @@ pub fn read_carmen_from<R: BufRead>(
         warned_fov: false,
         warned_flaser_fov: false,
     };
+    // While the lines of one batch are handled in order, the next batch's readings
+    // are parsed ahead on the pool's other threads.
     let mut batch = LineBatch::new();
+    batch.fill(&mut reader);
+    let mut ahead = prescan(&batch);
+    let mut next = LineBatch::new();
     let mut line_no: u64 = 0;
-    while !batch.last {
-        batch.fill(&mut reader);
-        let ahead = prescan(&batch);
-        for (k, (_, read)) in batch.lines.iter().enumerate() {
-            line_no += 1;
-            let text = batch.line(k);
-            match *read {
-                Line::Nul(column) => {
-                    return Err(LogError::NotText {
-                        file: name.to_string(),
-                        line: line_no,
-                        detail: format!(
-                            "a NUL byte at column {} (binary data; expected Carmen-style \
-                             text or a JSON log)",
-                            column + 1
-                        ),
-                    })
-                }
-                Line::TooLong => {
-                    let head = printable(&text[..text.len().min(40)], 20);
-                    let err = LogError::parse(
-                        name,
-                        line_no,
-                        "line",
-                        format!(
-                            "expected a line of at most {MAX_LINE_BYTES} bytes, found a \
-                             longer one starting `{head}`"
-                        ),
-                    );
-                    r.b.reject(err)?;
-                }
-                _ => r.line(text, line_no, ahead.get(k))?,
-            }
+    loop {
+        let more = !batch.last;
+        if more {
+            next.fill(&mut reader);
         }
+        let (handled, next_ahead) = rayon::join(
+            || r.batch(&batch, &ahead, &mut line_no),
+            || {
+                if more {
+                    prescan(&next)
+                } else {
+                    Prescan::default()
+                }
+            },
+        );
+        handled?;
         if let Some(e) = batch.error.take() {
             return Err(LogError::io(name, e));
         }
+        if !more {
+            break;
+        }
+        std::mem::swap(&mut batch, &mut next);
+        ahead = next_ahead;
     }
     r.b.log.stats.lines = line_no;
     for (k, (_, msg)) in MESSAGES.iter().enumerate() {
@@ -147,6 +139,48 @@ pub fn read_carmen_from<R: BufRead>(
 }
 
 impl CarmenReader<'_> {
+    /// Handles the lines of `batch` in order, numbering them on from `line_no`;
+    /// `ahead`: their readings parsed ahead.
+    fn batch(
+        &mut self,
+        batch: &LineBatch,
+        ahead: &Prescan,
+        line_no: &mut u64,
+    ) -> Result<(), LogError> {
+        for (k, (_, read)) in batch.lines.iter().enumerate() {
+            *line_no += 1;
+            let text = batch.line(k);
+            match *read {
+                Line::Nul(column) => {
+                    return Err(LogError::NotText {
+                        file: self.name.clone(),
+                        line: *line_no,
+                        detail: format!(
+                            "a NUL byte at column {} (binary data; expected Carmen-style \
+                             text or a JSON log)",
+                            column + 1
+                        ),
+                    })
+                }
+                Line::TooLong => {
+                    let head = printable(&text[..text.len().min(40)], 20);
+                    let err = LogError::parse(
+                        &self.name,
+                        *line_no,
+                        "line",
+                        format!(
+                            "expected a line of at most {MAX_LINE_BYTES} bytes, found a \
+                             longer one starting `{head}`"
+                        ),
+                    );
+                    self.b.reject(err)?;
+                }
+                _ => self.line(text, *line_no, ahead.get(k))?,
+            }
+        }
+        Ok(())
+    }
+
     /// Handles one line (with its `\n`, if any); `ready`: its readings, parsed ahead.
     fn line(&mut self, text: &[u8], line: u64, ready: Option<Ready<'_>>) -> Result<(), LogError> {
         let mut tokens = Tokens::new(text);

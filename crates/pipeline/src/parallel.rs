@@ -16,8 +16,9 @@ pub const CHUNK_PAIRS: usize = 64;
 
 /// Chunks per thread at least, when there are few pairs: a few hundred pairs (the
 /// bootstrap's) or a few dozen (the closure check's) in chunks of [`CHUNK_PAIRS`]
-/// would leave threads idle (60 pairs: one chunk, one thread).
-pub const CHUNKS_PER_THREAD: usize = 4;
+/// would leave threads idle (60 pairs: one chunk, one thread), and the last chunk
+/// matched alone is the time one thread waits for the other at the end.
+pub const CHUNKS_PER_THREAD: usize = 16;
 
 /// Pairs per chunk at least: a chunk of a chain prepares one scan more than it has
 /// pairs.
@@ -105,10 +106,9 @@ mod tests {
             })
         };
         let one = run(1);
-        assert_eq!(
-            prepared.swap(0, Ordering::Relaxed),
-            1001 + 1000 / CHUNK_PAIRS
-        );
+        // One scan more per chunk than it has pairs.
+        let chunks = 1000_usize.div_ceil(chunk_pairs(1000, 1));
+        assert_eq!(prepared.swap(0, Ordering::Relaxed), 1000 + chunks);
         let two = run(2);
         assert_eq!(one, two);
         assert_eq!(done.load(Ordering::Relaxed), 2000);
@@ -119,9 +119,10 @@ mod tests {
 
     #[test]
     fn few_pairs_are_cut_into_chunks_for_every_thread_and_keep_their_index() {
-        assert_eq!(chunk_pairs(60, 2), 7);
-        assert_eq!(chunk_pairs(300, 2), 37);
-        assert_eq!(chunk_pairs(1200, 2), CHUNK_PAIRS);
+        assert_eq!(chunk_pairs(60, 2), MIN_CHUNK_PAIRS);
+        assert_eq!(chunk_pairs(300, 2), 9);
+        assert_eq!(chunk_pairs(1200, 2), 37);
+        assert_eq!(chunk_pairs(4000, 2), CHUNK_PAIRS);
         assert_eq!(chunk_pairs(0, 2), MIN_CHUNK_PAIRS);
         assert_eq!(chunk_pairs(5, 0), MIN_CHUNK_PAIRS);
         let pairs: Vec<(usize, usize)> = (0..61).map(|i| (2 * i, 2 * i + 2)).collect();
