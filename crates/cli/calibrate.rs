@@ -270,12 +270,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     });
 
     // The results are printed whatever happens to --out and --report, so they are never lost.
+    // On the pool's threads: the figures are drawn on them.
     let written_report = args.report.as_ref().map(|path| {
-        write_html(path, &opts, &outcome, &report)
+        pool.install(|| write_html(path, &opts, &outcome, &report))
             .with_context(|| format!("cannot write the report {}", path.display()))
     });
     let written = args.out.as_ref().map(|dir| {
-        write_outputs(dir, &opts, &outcome, &report, args.plots)
+        pool.install(|| write_outputs(dir, &opts, &outcome, &report, args.plots))
             .with_context(|| format!("cannot write the results into {}", dir.display()))
     });
     if args.json {

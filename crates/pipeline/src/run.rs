@@ -615,7 +615,17 @@ pub fn calibrate_log(
     let heading = odometry_heading(&synced, opts);
     synced.heading_not_from_wheels = heading.as_ref().map(|fit| fit.cause());
     let t = Instant::now();
-    let calibration = solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
+    let samples: Vec<_> = synced
+        .samples
+        .iter()
+        .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
+        .collect();
+    // The halves' check needs only the samples: it runs beside the final solve.
+    let (calibration, consistency) = rayon::join(
+        || solve(&synced, opts),
+        || check_halves(&samples, &opts.solve_options()),
+    );
+    let calibration = calibration.map_err(|e| PipelineError::with_faults(e, &findings))?;
     if let Some(check) = synced.match_self_check.as_mut() {
         check.sigma_factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
     }
@@ -623,15 +633,6 @@ pub fn calibrate_log(
     // Named in the findings only when the numbers are shown (--accept-weak): a
     // refusal names it as its cause.
     findings.extend(heading.map(|fit| fit.finding()));
-
-    let t = Instant::now();
-    let samples: Vec<_> = synced
-        .samples
-        .iter()
-        .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
-        .collect();
-    let consistency = check_halves(&samples, &opts.solve_options());
-    timing.solve += t.elapsed().as_secs_f64();
 
     Ok(Outcome {
         health: findings,
