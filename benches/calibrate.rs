@@ -1,11 +1,16 @@
 //! End to end on the bundled demo log (`fixtures/demo.log`: 60 s of a simulated
 //! Khepera III with a URG-04LX): reading the file, synchronization + scan matching,
 //! solving (closed form, T-RO trimming, ML refinement, covariance) on the samples,
-//! and the whole `read → match → solve`, on every core.
+//! and the whole `read → match → solve`, on every core; and the reading and the
+//! writing of `samples.tuple` on one thread (`*_1_thread`: the reader parses scan
+//! readings ahead, and the tuples are rendered, on every thread of the pool it runs
+//! in, so the difference is what the threads gain).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use odocal_log::{read_log, ReadOptions};
-use odocal_pipeline::{calibrate_log, synchronize_and_match, NoProgress, Options, Timing};
+use odocal_pipeline::{
+    calibrate_log, synchronize_and_match, write_tuples, NoProgress, Options, Timing,
+};
 use std::hint::black_box;
 use std::path::Path;
 
@@ -37,7 +42,25 @@ fn bench(c: &mut Criterion) {
 
     let mut group = c.benchmark_group("calibrate/demo");
     group.sample_size(10);
+    let one_thread = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("thread pool");
     group.bench_function("read", |b| b.iter(|| black_box(read().scans.len())));
+    group.bench_function("read_1_thread", |b| {
+        b.iter(|| black_box(one_thread.install(read).scans.len()))
+    });
+    let tuples = std::env::temp_dir().join(format!("odocal-bench-{}.tuple", std::process::id()));
+    group.bench_function("write_tuples", |b| {
+        b.iter(|| write_tuples(&tuples, &synced.samples).expect("writes"))
+    });
+    group.bench_function("write_tuples_1_thread", |b| {
+        b.iter(|| {
+            one_thread
+                .install(|| write_tuples(&tuples, &synced.samples))
+                .expect("writes")
+        })
+    });
     group.bench_function("sync_and_match", |b| {
         b.iter(|| {
             let s = synchronize_and_match(&log, &opts, &NoProgress, &mut Timing::default())
@@ -56,6 +79,7 @@ fn bench(c: &mut Criterion) {
         })
     });
     group.finish();
+    let _ = std::fs::remove_file(&tuples);
 }
 
 criterion_group!(benches, bench);

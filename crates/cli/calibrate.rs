@@ -222,7 +222,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 .map_or_else(|| "LOG".into(), |p| p.display().to_string())
         );
     }
-    let inputs = input.read_lasers()?;
+    // On the pool's threads: the reader parses scan readings ahead on them.
+    let inputs = pool.install(|| input.read_lasers())?;
     let parse_s = t_parse.elapsed().as_secs_f64();
     // One entry per laser's log: a bag read for several scan topics is one per topic.
     let several_topics = input.read.scan_topic.len() > 1;
@@ -389,12 +390,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     });
 
     // The results are printed whatever happens to --out and --report, so they are never lost.
+    // On the pool's threads: the figures are drawn on them.
     let written_report = args.report.as_ref().map(|path| {
-        write_html(path, &opts, &outcome, &report)
+        pool.install(|| write_html(path, &opts, &outcome, &report))
             .with_context(|| format!("cannot write the report {}", path.display()))
     });
     let written = args.out.as_ref().map(|dir| {
-        write_outputs(dir, &opts, &outcome, &report, args.plots)
+        pool.install(|| write_outputs(dir, &opts, &outcome, &report, args.plots))
             .with_context(|| format!("cannot write the results into {}", dir.display()))
     });
     if args.json {

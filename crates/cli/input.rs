@@ -28,7 +28,8 @@ pub struct InputArgs {
     /// check on every run finds the clocks clearly offset.
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     pub time_offset: Option<f64>,
-    /// Threads for scan matching (default: all cores).
+    /// Threads for scan matching (calibrate: also for reading the log's scans and
+    /// drawing the report; default: all cores).
     #[arg(long, value_name = "N")]
     pub threads: Option<usize>,
     /// Nominal parameters "r_L,r_R,b" or "r_L,r_R,b,l_x,l_y,l_theta" (m, rad): first

@@ -11,6 +11,7 @@ use std::process::ExitCode;
 
 mod calibrate;
 mod export;
+mod hashing_thread;
 mod heading_refusal;
 mod info;
 mod input;

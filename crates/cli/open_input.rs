@@ -1,14 +1,14 @@
 //! Opening the input: a ROS bag is read by path (its readers seek), a Carmen or JSON
 //! log is read once from start to end, so it may come through a pipe, a FIFO, process
 //! substitution (`<(zcat run.log.gz)`) or standard input (`-`), and its checksum is
-//! computed on the same pass.
+//! computed on the same pass (read and hashed on another thread: [`HashedInput`]).
 
+use crate::hashing_thread::HashedInput;
 use anyhow::Context;
 use odocal_bag::{bag_format_of_head, detect_bag};
 use odocal_log::{read_log_from, Log, LogError, ReadOptions};
-use odocal_report::provenance::Sha256Reader;
 use std::fs::File;
-use std::io::{self, BufReader, Cursor, Read};
+use std::io::{self, Cursor, Read};
 use std::path::Path;
 
 /// Bytes read ahead to tell a bag from a text log, and all the log reader checks for
@@ -50,12 +50,12 @@ pub fn is_bag_file(path: &Path) -> anyhow::Result<bool> {
 /// with the SHA-256 and size of the input.
 pub fn read_text_log(path: &Path, opts: &ReadOptions) -> anyhow::Result<(Log, (String, u64))> {
     let name = input_name(path);
-    let source: Box<dyn Read> = if is_stdin(path) {
-        Box::new(io::stdin().lock())
+    let source: Box<dyn Read + Send> = if is_stdin(path) {
+        Box::new(io::stdin())
     } else {
         Box::new(File::open(path).map_err(|e| LogError::io(&name, e))?)
     };
-    let mut hashing = Sha256Reader::new(source);
+    let mut hashing = HashedInput::new(source).map_err(|e| LogError::io(&name, e))?;
     let mut head = Vec::new();
     (&mut hashing)
         .take(HEAD_BYTES)
@@ -68,7 +68,8 @@ pub fn read_text_log(path: &Path, opts: &ReadOptions) -> anyhow::Result<(Log, (S
              run.bag`) and give that file"
         );
     }
-    let reader = BufReader::with_capacity(1 << 18, Cursor::new(head).chain(&mut hashing));
+    // Buffered already: the head, then the hashed input's chunks.
+    let reader = Cursor::new(head).chain(&mut hashing);
     // The reader's message already says everything (file, line, cause).
     let log = read_log_from(reader, &name, opts).map_err(|e| anyhow::anyhow!("{e}"))?;
     let checksum = hashing

@@ -6,10 +6,12 @@
 
 use crate::builder::{LogBuilder, Stream};
 use crate::error::LogError;
-use crate::line_reader::{read_line, Line, MAX_LINE_BYTES};
+use crate::line_batch::LineBatch;
+use crate::line_reader::{Line, MAX_LINE_BYTES};
 use crate::model::{LaserFields, Log, OdomRecord, ScanGeometry, ScanKind, ValueSource};
 use crate::options::{is_valid_modulus, ReadOptions};
 use crate::printable::printable;
+use crate::range_prescan::{prescan, Prescan, Ready};
 use crate::tokens::{FieldError, Fields, Tokens};
 use odocal_geom::Pose2;
 use std::io::BufRead;
@@ -95,41 +97,37 @@ pub fn read_carmen_from<R: BufRead>(
         warned_fov: false,
         warned_flaser_fov: false,
     };
-    let mut buf: Vec<u8> = Vec::with_capacity(1 << 16);
+    // While the lines of one batch are handled in order, the next batch's readings
+    // are parsed ahead on the pool's other threads.
+    let mut batch = LineBatch::new();
+    batch.fill(&mut reader);
+    let mut ahead = prescan(&batch);
+    let mut next = LineBatch::new();
     let mut line_no: u64 = 0;
     loop {
-        let read = read_line(&mut reader, &mut buf).map_err(|e| LogError::io(name, e))?;
-        if read == Line::End {
+        let more = !batch.last;
+        if more {
+            next.fill(&mut reader);
+        }
+        let (handled, next_ahead) = rayon::join(
+            || r.batch(&batch, &ahead, &mut line_no),
+            || {
+                if more {
+                    prescan(&next)
+                } else {
+                    Prescan::default()
+                }
+            },
+        );
+        handled?;
+        if let Some(e) = batch.error.take() {
+            return Err(LogError::io(name, e));
+        }
+        if !more {
             break;
         }
-        line_no += 1;
-        match read {
-            Line::Nul(column) => {
-                return Err(LogError::NotText {
-                    file: name.to_string(),
-                    line: line_no,
-                    detail: format!(
-                        "a NUL byte at column {} (binary data; expected Carmen-style text \
-                         or a JSON log)",
-                        column + 1
-                    ),
-                })
-            }
-            Line::TooLong => {
-                let head = printable(&buf[..buf.len().min(40)], 20);
-                let err = LogError::parse(
-                    name,
-                    line_no,
-                    "line",
-                    format!(
-                        "expected a line of at most {MAX_LINE_BYTES} bytes, found a longer \
-                         one starting `{head}`"
-                    ),
-                );
-                r.b.reject(err)?;
-            }
-            _ => r.line(&buf, line_no)?,
-        }
+        std::mem::swap(&mut batch, &mut next);
+        ahead = next_ahead;
     }
     r.b.log.stats.lines = line_no;
     for (k, (_, msg)) in MESSAGES.iter().enumerate() {
@@ -141,8 +139,50 @@ pub fn read_carmen_from<R: BufRead>(
 }
 
 impl CarmenReader<'_> {
-    /// Handles one line (with its `\n`, if any).
-    fn line(&mut self, text: &[u8], line: u64) -> Result<(), LogError> {
+    /// Handles the lines of `batch` in order, numbering them on from `line_no`;
+    /// `ahead`: their readings parsed ahead.
+    fn batch(
+        &mut self,
+        batch: &LineBatch,
+        ahead: &Prescan,
+        line_no: &mut u64,
+    ) -> Result<(), LogError> {
+        for (k, (_, read)) in batch.lines.iter().enumerate() {
+            *line_no += 1;
+            let text = batch.line(k);
+            match *read {
+                Line::Nul(column) => {
+                    return Err(LogError::NotText {
+                        file: self.name.clone(),
+                        line: *line_no,
+                        detail: format!(
+                            "a NUL byte at column {} (binary data; expected Carmen-style \
+                             text or a JSON log)",
+                            column + 1
+                        ),
+                    })
+                }
+                Line::TooLong => {
+                    let head = printable(&text[..text.len().min(40)], 20);
+                    let err = LogError::parse(
+                        &self.name,
+                        *line_no,
+                        "line",
+                        format!(
+                            "expected a line of at most {MAX_LINE_BYTES} bytes, found a \
+                             longer one starting `{head}`"
+                        ),
+                    );
+                    self.b.reject(err)?;
+                }
+                _ => self.line(text, *line_no, ahead.get(k))?,
+            }
+        }
+        Ok(())
+    }
+
+    /// Handles one line (with its `\n`, if any); `ready`: its readings, parsed ahead.
+    fn line(&mut self, text: &[u8], line: u64, ready: Option<Ready<'_>>) -> Result<(), LogError> {
         let mut tokens = Tokens::new(text);
         let Some(first) = tokens.next() else {
             self.b.log.stats.blank += 1;
@@ -165,8 +205,8 @@ impl CarmenReader<'_> {
         let result = match msg {
             Message::Param => self.param(&mut f, line),
             Message::Encoder => self.encoder(&mut f, line),
-            Message::RawLaser1 | Message::RobotLaser1 => self.laser(&mut f, msg, line),
-            Message::FLaser => self.flaser(&mut f, line),
+            Message::RawLaser1 | Message::RobotLaser1 => self.laser(&mut f, msg, line, ready),
+            Message::FLaser => self.flaser(&mut f, line, ready),
             Message::Odom => self.odom(&mut f, line),
         };
         match result {
@@ -294,7 +334,13 @@ impl CarmenReader<'_> {
     }
 
     /// RAWLASER1 and ROBOTLASER1.
-    fn laser(&mut self, f: &mut Fields<'_>, msg: Message, line: u64) -> Result<(), FieldError> {
+    fn laser(
+        &mut self,
+        f: &mut Fields<'_>,
+        msg: Message,
+        line: u64,
+        ready: Option<Ready<'_>>,
+    ) -> Result<(), FieldError> {
         let h = LaserFields {
             laser_type: f.i32("laser_type")?,
             start_angle: f.finite_f64("start_angle")?,
@@ -314,7 +360,7 @@ impl CarmenReader<'_> {
         let n = f.count("num_readings")?;
         let store = &mut self.b.log.scans;
         let (r0, m0) = (store.ranges.len(), store.remissions.len());
-        let body = Self::laser_body(f, msg, n, &mut store.ranges, &mut store.remissions);
+        let body = Self::laser_body(f, msg, n, ready, &mut store.ranges, &mut store.remissions);
         let t = match body {
             Ok(t) => t,
             Err(e) => {
@@ -352,6 +398,7 @@ impl CarmenReader<'_> {
         f: &mut Fields<'_>,
         msg: Message,
         n: usize,
+        ready: Option<Ready<'_>>,
         ranges: &mut Vec<f32>,
         remissions: &mut Vec<f32>,
     ) -> Result<f64, FieldError> {
@@ -364,12 +411,7 @@ impl CarmenReader<'_> {
             ),
             found: e.found,
         };
-        for _ in 0..n {
-            match f.f32("range reading") {
-                Ok(r) => ranges.push(r),
-                Err(e) => return Err(explain(e, f, None)),
-            }
-        }
+        Self::readings(f, n, ready, ranges).map_err(|e| explain(e, f, None))?;
         let k = f.count("num_remissions").map_err(|e| explain(e, f, None))?;
         for _ in 0..k {
             remissions.push(f.f32("remission").map_err(|e| explain(e, f, Some(k)))?);
@@ -392,6 +434,26 @@ impl CarmenReader<'_> {
             }
         }
         Self::trailer(f).map_err(|e| explain(e, f, Some(k)))
+    }
+
+    /// The `n` range readings that come next on the line, appended to `ranges`: the
+    /// ones parsed ahead when they start where the line's tokens are now (then they
+    /// are the same tokens, parsed by the same function), else parsed here.
+    fn readings(
+        f: &mut Fields<'_>,
+        n: usize,
+        ready: Option<Ready<'_>>,
+        ranges: &mut Vec<f32>,
+    ) -> Result<(), FieldError> {
+        if let Some(r) = ready.filter(|r| r.start == f.tokens.position() && r.values.len() == n) {
+            ranges.extend_from_slice(r.values);
+            f.tokens.resume_at(r.end);
+            return Ok(());
+        }
+        for _ in 0..n {
+            ranges.push(f.f32("range reading")?);
+        }
+        Ok(())
     }
 
     /// Minimum range of the scans read now: the reader's option, else the log's PARAM.
@@ -422,14 +484,17 @@ impl CarmenReader<'_> {
         i
     }
 
-    fn flaser(&mut self, f: &mut Fields<'_>, line: u64) -> Result<(), FieldError> {
+    fn flaser(
+        &mut self,
+        f: &mut Fields<'_>,
+        line: u64,
+        ready: Option<Ready<'_>>,
+    ) -> Result<(), FieldError> {
         let n = f.count("num_readings")?;
         let store = &mut self.b.log.scans;
         let r0 = store.ranges.len();
         let body = (|| {
-            for _ in 0..n {
-                store.ranges.push(f.f32("range reading")?);
-            }
+            Self::readings(f, n, ready, &mut store.ranges)?;
             for what in ["x", "y", "theta", "odom_x", "odom_y", "odom_theta"] {
                 f.f64(what)?;
             }

@@ -23,8 +23,16 @@ pub(crate) enum Line {
 }
 
 /// Reads one line into `buf` (cleared first), keeping at most [`MAX_LINE_BYTES`].
+#[cfg(test)]
 pub(crate) fn read_line<R: BufRead>(reader: &mut R, buf: &mut Vec<u8>) -> io::Result<Line> {
     buf.clear();
+    append_line(reader, buf)
+}
+
+/// Reads one line onto the end of `buf`, keeping at most [`MAX_LINE_BYTES`] of it:
+/// the line is `buf[len before..]` (its beginning only, when [`Line::TooLong`]).
+pub(crate) fn append_line<R: BufRead>(reader: &mut R, buf: &mut Vec<u8>) -> io::Result<Line> {
+    let start = buf.len();
     let mut too_long = false;
     let mut nul: Option<usize> = None;
     let mut seen = 0usize;
@@ -47,7 +55,7 @@ pub(crate) fn read_line<R: BufRead>(reader: &mut R, buf: &mut Vec<u8>) -> io::Re
             }
         }
         if !too_long && nul.is_none() {
-            let room = MAX_LINE_BYTES - buf.len();
+            let room = MAX_LINE_BYTES - (buf.len() - start);
             if take > room {
                 buf.extend_from_slice(&chunk[..room]);
                 too_long = true;

@@ -447,7 +447,11 @@ impl ScanStore {
 
     /// Readings that are not valid ranges (out of range, 0, non-finite), over all scans.
     pub fn count_invalid_readings(&self) -> u64 {
-        self.iter()
+        use rayon::prelude::*;
+        // On the current rayon pool's threads (an integer sum: the same on any number).
+        (0..self.len())
+            .into_par_iter()
+            .filter_map(|i| self.get(i))
             .map(|s| {
                 s.ranges
                     .iter()

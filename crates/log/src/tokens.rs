@@ -71,6 +71,19 @@ impl<'a> Tokens<'a> {
         (self.i < self.s.len()).then_some(self.i)
     }
 
+    /// The byte offset in the line where the search for the next token starts.
+    #[inline]
+    pub(crate) fn position(&self) -> usize {
+        self.i
+    }
+
+    /// Moves the search for the next token to byte offset `i` of the line (a
+    /// [`Tokens::position`] of the same line).
+    #[inline]
+    pub(crate) fn resume_at(&mut self, i: usize) {
+        self.i = i.min(self.s.len());
+    }
+
     /// How many tokens are left (used only to explain an error).
     pub(crate) fn count_remaining(&self) -> usize {
         self.clone().count()

@@ -64,9 +64,10 @@ pub fn check_halves(samples: &[Sample], options: &SolveOptions) -> Consistency {
     let solve = |part: &[Sample], name: &str| {
         calibrate(part, &opts).map_err(|e| format!("the {name} half alone: {e}"))
     };
-    match (
-        solve(&samples[..half], "first"),
-        solve(&samples[half..], "second"),
+    // Both halves are solved (on two threads when the pool has them).
+    match rayon::join(
+        || solve(&samples[..half], "first"),
+        || solve(&samples[half..], "second"),
     ) {
         (Ok(a), Ok(b)) => match undetermined_half(&a, &b, options) {
             Some(reason) => Consistency::NotAvailable { reason },

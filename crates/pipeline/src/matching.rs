@@ -5,6 +5,7 @@ use crate::rejection::{MatchFailure, Rejection};
 use odocal_geom::Pose2;
 use odocal_icp::{IcpParams, Matcher, PreparedScan};
 use odocal_log::ScanStore;
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// What the scan matcher returned for one pair, kept for the tuples and the report.
@@ -31,8 +32,10 @@ pub const NOISE_SAMPLE_SCANS: usize = 64;
 /// sparse to show their own.
 pub fn typical_noise_sigma(scans: &ScanStore, params: &IcpParams) -> f64 {
     let every = (scans.len() / NOISE_SAMPLE_SCANS).max(1);
-    let mut noise: Vec<f64> = (0..scans.len())
-        .step_by(every)
+    let sampled: Vec<usize> = (0..scans.len()).step_by(every).collect();
+    // On the current pool's threads; collected in scan order.
+    let mut noise: Vec<f64> = sampled
+        .into_par_iter()
         .filter_map(|i| {
             let s = scans.get(i)?;
             PreparedScan::new(
@@ -51,6 +54,20 @@ pub fn typical_noise_sigma(scans: &ScanStore, params: &IcpParams) -> f64 {
     }
     let mid = noise.len() / 2;
     *noise.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// `params` with [`IcpParams::typical_noise_sigma`] set to `store_noise` (the store's
+/// [`typical_noise_sigma`]) when it is 0, i.e. not given: what [`match_pairs`] would
+/// estimate itself, estimated once for several calls.
+pub fn with_typical_noise(params: &IcpParams, store_noise: f64) -> IcpParams {
+    IcpParams {
+        typical_noise_sigma: if params.typical_noise_sigma == 0.0 {
+            store_noise
+        } else {
+            params.typical_noise_sigma
+        },
+        ..params.clone()
+    }
 }
 
 /// Where a scan is in its source, for a message: its line in a text log; in a bag, its
@@ -82,11 +99,10 @@ pub fn match_pairs(
     done: impl Fn() + Sync + Send,
 ) -> Vec<Result<MatchStats, MatchFailure>> {
     debug_assert_eq!(pairs.len(), first_guesses.len());
-    let mut own_params;
+    let own_params;
     let mut params = params;
     if params.typical_noise_sigma == 0.0 {
-        own_params = params.clone();
-        own_params.typical_noise_sigma = typical_noise_sigma(scans, params);
+        own_params = with_typical_noise(params, typical_noise_sigma(scans, params));
         params = &own_params;
     }
     let prepare = |i: usize| match scans.get(i) {

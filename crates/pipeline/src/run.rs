@@ -4,7 +4,7 @@ use crate::consistency::{check_halves, Consistency};
 use crate::error::PipelineError;
 use crate::finding::{Finding, FindingKind};
 use crate::health;
-use crate::matching::{match_pairs, MatchStats};
+use crate::matching::{match_pairs, typical_noise_sigma, with_typical_noise, MatchStats};
 use crate::options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
 use crate::progress::Progress;
 use crate::refusal;
@@ -173,6 +173,9 @@ pub fn synchronize_and_match(
     let mut matched: Vec<Option<Result<MatchStats, MatchFailure>>> = vec![None; kept.len()];
     let mut guess_params = opts.initial_params;
     let bootstrap = (opts.bootstrap_guesses || sweep) && kept.len() >= MIN_SAMPLES;
+    // The log's typical range noise, estimated once for every match of its scans.
+    let log_noise = typical_noise_sigma(&log.scans, &opts.icp);
+    let log_icp = with_typical_noise(&opts.icp, log_noise);
     if guess_params.is_none() && bootstrap {
         // Match a subset with identity guesses (an evenly spread one of long logs,
         // every pair of short ones), solve roughly, and guess the rest — and the
@@ -186,7 +189,7 @@ pub fn synchronize_and_match(
         };
         let sub_pairs: Vec<(usize, usize)> = subset.iter().map(|&i| index_pairs[i]).collect();
         let identity = vec![Pose2::IDENTITY; subset.len()];
-        let results = match_pairs(&log.scans, &sub_pairs, &identity, &opts.icp, || {
+        let results = match_pairs(&log.scans, &sub_pairs, &identity, &log_icp, || {
             progress.advance()
         });
         let samples: Vec<_> = subset
@@ -245,14 +248,19 @@ pub fn synchronize_and_match(
             });
         }
     }
+    let (noise, icp) = match &scans {
+        Cow::Borrowed(_) => (log_noise, log_icp),
+        Cow::Owned(store) => {
+            let noise = typical_noise_sigma(store, &opts.icp);
+            (noise, with_typical_noise(&opts.icp, noise))
+        }
+    };
     let rest: Vec<usize> = (0..kept.len()).filter(|&i| matched[i].is_none()).collect();
     let rest_motions: Vec<(usize, WheelMotion)> =
         rest.iter().map(|&i| (i, kept[i].1.clone())).collect();
     let guesses = first_guesses(&rest_motions, guess_params.as_ref(), opts.use_profile);
     let rest_pairs: Vec<(usize, usize)> = rest.iter().map(|&i| index_pairs[i]).collect();
-    let results = match_pairs(&scans, &rest_pairs, &guesses, &opts.icp, || {
-        progress.advance()
-    });
+    let results = match_pairs(&scans, &rest_pairs, &guesses, &icp, || progress.advance());
     let sweep_compensated = matches!(scans, Cow::Owned(_));
     for (i, r) in rest.into_iter().zip(results) {
         matched[i] = Some(r);
@@ -276,7 +284,7 @@ pub fn synchronize_and_match(
             }
         }
     }
-    let match_self_check = crate::self_check::closure_check(&scans, &samples, &opts.icp);
+    let match_self_check = crate::self_check::closure_check(&scans, &samples, &icp, noise);
     Ok(Synchronized {
         stride,
         limits,
@@ -617,7 +625,17 @@ pub fn calibrate_log(
     let heading = odometry_heading(&synced, opts);
     synced.heading_not_from_wheels = heading.as_ref().map(|fit| fit.cause());
     let t = Instant::now();
-    let calibration = solve(&synced, opts).map_err(|e| PipelineError::with_faults(e, &findings))?;
+    let samples: Vec<_> = synced
+        .samples
+        .iter()
+        .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
+        .collect();
+    // The halves' check needs only the samples: it runs beside the final solve.
+    let (calibration, consistency) = rayon::join(
+        || solve(&synced, opts),
+        || check_halves(&samples, &opts.solve_options()),
+    );
+    let calibration = calibration.map_err(|e| PipelineError::with_faults(e, &findings))?;
     if let Some(check) = synced.match_self_check.as_mut() {
         check.sigma_factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
     }
@@ -629,15 +647,6 @@ pub fn calibrate_log(
         &calibration,
         opts.lateral_slip,
     ));
-
-    let t = Instant::now();
-    let samples: Vec<_> = synced
-        .samples
-        .iter()
-        .map(|s| s.to_solver(opts.use_profile, opts.use_icp_covariance))
-        .collect();
-    let consistency = check_halves(&samples, &opts.solve_options());
-    timing.solve += t.elapsed().as_secs_f64();
 
     Ok(Outcome {
         health: findings,

@@ -5,7 +5,8 @@ use crate::matching::MatchStats;
 use crate::sync::{ScanPair, WheelMotion};
 use odocal_log::{write_tuple, TupleRecord};
 use odocal_solver::{ProfileSegment, Sample};
-use std::io;
+use rayon::prelude::*;
+use std::io::{self, Write};
 use std::path::Path;
 
 /// One scan pair that survived synchronization and matching.
@@ -104,12 +105,102 @@ pub fn wheel_only_sample(w: &WheelMotion) -> Sample {
     }
 }
 
-/// Writes the samples as tuples, one JSON object per line.
+/// Samples whose tuples are rendered together before they are written (bounded
+/// memory: about 2 kB of text each).
+const TUPLES_PER_BLOCK: usize = 4096;
+/// Samples rendered by one thread at a time within a block.
+const TUPLES_PER_PART: usize = 128;
+
+/// Writes the samples as tuples, one JSON object per line. The text is rendered on
+/// the current rayon pool's threads, a block at a time, and written in order.
 pub fn write_tuples(path: &Path, samples: &[PairSample]) -> io::Result<()> {
     crate::atomic_file::write_atomically(path, |w| {
-        for s in samples {
-            write_tuple(&mut *w, &s.to_tuple())?;
+        for block in samples.chunks(TUPLES_PER_BLOCK) {
+            let parts: Vec<io::Result<Vec<u8>>> = block
+                .par_chunks(TUPLES_PER_PART)
+                .map(|part| {
+                    let mut text = Vec::with_capacity(2048 * part.len());
+                    for s in part {
+                        write_tuple(&mut text, &s.to_tuple())?;
+                    }
+                    Ok(text)
+                })
+                .collect();
+            for text in parts {
+                w.write_all(&text?)?;
+            }
         }
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sync::ProfilePiece;
+    use odocal_geom::Pose2;
+
+    fn sample(k: usize) -> PairSample {
+        let x = k as f64;
+        PairSample {
+            pair: ScanPair {
+                first: 4 * k,
+                second: 4 * k + 4,
+                t0: 0.4 * x,
+                t1: 0.4 * x + 0.4,
+            },
+            wheel: WheelMotion {
+                t0: 0.4 * x,
+                dt: 0.4,
+                dphi_l: 0.1 + 1e-3 * x,
+                dphi_r: 0.1 - 1e-3 * x / 3.0,
+                profile: vec![ProfilePiece {
+                    dt: 0.4,
+                    dphi_l: 0.1 + 1e-3 * x,
+                    dphi_r: 0.1 - 1e-3 * x / 3.0,
+                }],
+            },
+            icp: MatchStats {
+                pose: Pose2 {
+                    x: 0.02 + x / 7e4,
+                    y: -x / 9e5,
+                    theta: (x / 1e3).sin(),
+                },
+                covariance: [
+                    [1e-7 * (1.0 + x), 0.0, 0.0],
+                    [0.0, 1e-7, 0.0],
+                    [0.0, 0.0, 1e-8],
+                ],
+                iterations: k as u32 % 17,
+                correspondences: 600 + k % 50,
+                mean_residual: 1e-3 / (1.0 + x),
+            },
+        }
+    }
+
+    #[test]
+    fn tuples_rendered_on_several_threads_are_the_sequential_text() {
+        // Several blocks, parts and a remainder.
+        let samples: Vec<PairSample> = (0..TUPLES_PER_BLOCK + 3 * TUPLES_PER_PART + 5)
+            .map(sample)
+            .collect();
+        let mut expected = Vec::new();
+        for s in &samples {
+            write_tuple(&mut expected, &s.to_tuple()).unwrap();
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("samples.tuple");
+        for threads in [1, 3] {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| write_tuples(&path, &samples))
+                .unwrap();
+            assert!(
+                std::fs::read(&path).unwrap() == expected,
+                "{threads} threads"
+            );
+        }
+    }
 }

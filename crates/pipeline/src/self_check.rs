@@ -41,10 +41,14 @@ pub struct MatchSelfCheck {
 
 /// Measures the matcher's error on `samples` (in time order) with the scans they
 /// were matched on; `None` when fewer than [`MIN_TRIPLES`] triples close.
+/// `range_noise_m` is the store's [`crate::matching::typical_noise_sigma`], and
+/// `params` those the samples were matched with, their typical noise set (see
+/// [`crate::matching::with_typical_noise`]).
 pub fn closure_check(
     scans: &ScanStore,
     samples: &[PairSample],
     params: &IcpParams,
+    range_noise_m: f64,
 ) -> Option<MatchSelfCheck> {
     let triples: Vec<(&MatchStats, &MatchStats, (usize, usize))> = samples
         .windows(2)
@@ -62,18 +66,7 @@ pub fn closure_check(
         .map(|(ab, bc, _)| ab.pose.compose(&bc.pose))
         .collect();
     let pairs: Vec<(usize, usize)> = chosen.iter().map(|t| t.2).collect();
-    // The store's typical noise, estimated once: for the figure and for the matcher
-    // (which would otherwise estimate it again).
-    let range_noise_m = crate::matching::typical_noise_sigma(scans, params);
-    let params = IcpParams {
-        typical_noise_sigma: if params.typical_noise_sigma == 0.0 {
-            range_noise_m
-        } else {
-            params.typical_noise_sigma
-        },
-        ..params.clone()
-    };
-    let direct = match_pairs(scans, &pairs, &chained, &params, || {});
+    let direct = match_pairs(scans, &pairs, &chained, params, || {});
     let (mut sum_xy, mut sum_theta, mut n) = (0.0, 0.0, 0usize);
     for (d, c) in direct.iter().zip(&chained) {
         let Ok(d) = d else { continue };

@@ -91,10 +91,16 @@ fn results_do_not_depend_on_the_thread_count() {
     let (_, log) = sim(33, 250.0, 0.0);
     let opts = Options::default();
     let one = in_pool(1, || calibrate_log(&log, &opts, &NoProgress).unwrap());
-    let two = in_pool(2, || calibrate_log(&log, &opts, &NoProgress).unwrap());
-    assert_eq!(one.synced.samples, two.synced.samples);
-    assert_eq!(one.calibration.params, two.calibration.params);
-    assert_eq!(one.calibration.covariance, two.calibration.covariance);
+    // Chunks of the pairs, and the noise estimate's scans, spread over the threads.
+    for threads in [2, 3] {
+        let two = in_pool(threads, || calibrate_log(&log, &opts, &NoProgress).unwrap());
+        assert_eq!(one.synced.samples, two.synced.samples);
+        assert!(one.synced.match_self_check.is_some());
+        assert_eq!(one.synced.match_self_check, two.synced.match_self_check);
+        assert_eq!(one.synced.match_rejections, two.synced.match_rejections);
+        assert_eq!(one.calibration.params, two.calibration.params);
+        assert_eq!(one.calibration.covariance, two.calibration.covariance);
+    }
 }
 
 #[test]

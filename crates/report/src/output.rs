@@ -61,8 +61,12 @@ pub fn write_outputs(
     report: &Report,
     plots: bool,
 ) -> io::Result<()> {
-    let json = serde_json::to_string_pretty(report).map_err(io::Error::other)?;
-    let figs = drawn(opts, outcome, report)?;
+    // The figures are drawn while results.json is written out.
+    let (json, figs) = rayon::join(
+        || serde_json::to_string_pretty(report).map_err(io::Error::other),
+        || drawn(opts, outcome, report),
+    );
+    let (json, figs) = (json?, figs?);
     let ros_yaml = diff_drive_controller_yaml(&report.params);
     let ros_urdf = laser_joints_urdf(&report.params, &report.laser_poses());
     write_dir_atomically(dir, &is_output_name, |fresh| {

@@ -16,6 +16,7 @@ pub use data::FigureData;
 
 use crate::report::Report;
 use odocal_pipeline::{Options, Outcome};
+use rayon::prelude::*;
 
 /// One figure: a file stem (for `--plots`), a title and a caption for the page, and
 /// the SVG document.
@@ -42,15 +43,27 @@ pub fn figures(
     report: &Report,
 ) -> Result<Vec<Figure>, DrawError> {
     let d = FigureData::new(opts, outcome, report);
-    let mut out = vec![
-        trajectory::figure(&d)?,
-        residuals::figure(&d)?,
-        histograms::figure(&d)?,
-        coverage::figure(&d)?,
+    type Draw = fn(&FigureData) -> Result<Figure, DrawError>;
+    let draws: [Draw; 4] = [
+        trajectory::figure,
+        residuals::figure,
+        histograms::figure,
+        coverage::figure,
     ];
+    // Drawn on the current rayon pool's threads (each figure alone), kept in order.
+    let (drawn, icp) = rayon::join(
+        || {
+            draws
+                .par_iter()
+                .map(|draw| draw(&d).map_err(|e| e.to_string()))
+                .collect::<Vec<_>>()
+        },
+        || icp::figure(&d).map_err(|e| e.to_string()),
+    );
+    let mut out = drawn.into_iter().collect::<Result<Vec<_>, _>>()?;
     if let Some(o) = &outcome.offset {
         out.push(time_offset::figure(o)?);
     }
-    out.push(icp::figure(&d)?);
+    out.push(icp?);
     Ok(out)
 }
