@@ -11,8 +11,7 @@ use crate::terminal::{errln, out, outln, write_json_stdout};
 use anyhow::Context;
 use odocal_log::Log;
 use odocal_pipeline::{
-    calibrate_log, calibrate_logs_with_lasers, laser_indices, LaserSetup, Options, SlideModel,
-    Trim,
+    calibrate_log, calibrate_logs_with_lasers, laser_indices, LaserSetup, Options, SlideModel, Trim,
 };
 use odocal_report::{
     build_joint_report, build_report, sha256_of_input, write_html, write_outputs, NominalLaserPose,
