@@ -141,11 +141,11 @@ fn the_command_line_chooses_the_model() {
 #[test]
 fn the_real_mines_logs_leave_the_slide_undetermined_and_say_so() {
     // The real MinesRover logs (read from ../shared/real/mines beside the repository,
-    // skipped with a notice when absent): with the merged matcher k is 3.6σ on exp1 and
-    // 3.3σ on exp2, below the 4σ at which it is applied, so the default keeps the
-    // six-parameter estimate; exp1 (and, with these numbers, exp2) gets a note naming
-    // --lateral-slip, since the slide would move ℓx by more than its σ. Estimated, the
-    // two logs' k agree within 3σ.
+    // skipped with a notice when absent): k is 2.5σ on exp1 and −1.3σ on exp2, so the
+    // default keeps the six-parameter estimate, and exp1 gets a note naming
+    // --lateral-slip (the slide would move its ℓx by more than its σ); whether exp2
+    // gets one depends on how many of its pairs the matcher keeps, so it is printed,
+    // not asserted. Estimated, the two logs' k agree within 3σ.
     let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/real/mines");
     let mut slides = Vec::new();
     for name in ["exp1.log", "exp2.log"] {
