@@ -11,6 +11,7 @@
 
 use crate::calibrate::{calibrate, Calibration, NoiseSource, SolveOptions};
 use crate::constraints::{Constraint, Constraints};
+use crate::damping::Damping;
 use crate::error::SolveError;
 use crate::kinematics::{residual_of, Predictor};
 use crate::linalg::information_from_covariance;
@@ -26,9 +27,6 @@ use serde::Serialize;
 
 /// Largest number of Levenberg–Marquardt iterations of the joint refinement.
 const MAX_ITERATIONS: usize = 100;
-
-/// Relative decrease of the cost below which the joint refinement stops.
-const RELATIVE_TOLERANCE: f64 = 1e-12;
 
 /// Smallest eigenvalue, relative to the largest, of the unit-diagonal joint
 /// information below which a direction counts as not determined.
@@ -424,23 +422,22 @@ fn refine_joint(
     let mut params = start;
     let (mut cost, mut h, mut g) = constrained_normal_equations(groups, &params, constraints);
     let cost_before = cost;
-    let mut lambda = 1e-6;
+    let mut damping = Damping::new();
     let mut iterations = 0;
     while iterations < MAX_ITERATIONS && cost.is_finite() && cost > 0.0 {
         iterations += 1;
         let (hs, s) = unit_diagonal(&h);
-        let damped = hs.clone() + DMatrix::identity(n, n) * lambda;
+        let damped = hs.clone() + DMatrix::identity(n, n) * damping.lambda();
         let gs = g.component_mul(&s);
         let Some(chol) = damped.cholesky() else {
-            lambda *= 10.0;
-            if lambda > 1e12 {
+            if damping.rejected() {
                 break;
             }
             continue;
         };
         let step = -chol.solve(&gs);
         let predicted = -2.0 * gs.dot(&step) - (&hs * &step).dot(&step);
-        if predicted <= RELATIVE_TOLERANCE * cost {
+        if Damping::negligible(predicted, cost) {
             break;
         }
         let mut trial = params.clone();
@@ -454,15 +451,11 @@ fn refine_joint(
         if t_cost.is_finite() && t_cost <= cost {
             let decrease = cost - t_cost;
             (params, cost, h, g) = (trial, t_cost, t_h, t_g);
-            lambda = (lambda * 0.1).max(1e-12);
-            if decrease <= RELATIVE_TOLERANCE * cost {
+            if damping.accepted(decrease, cost) {
                 break;
             }
-        } else {
-            lambda *= 10.0;
-            if lambda > 1e12 {
-                break;
-            }
+        } else if damping.rejected() {
+            break;
         }
     }
     (params, cost_before, cost, iterations, h)

@@ -10,6 +10,7 @@
 
 use crate::calibrate::{Calibration, SolveOptions};
 use crate::constraints::Constraints;
+use crate::damping::Damping;
 use crate::kinematics::residual_of;
 use crate::linalg::unit_diagonal;
 use crate::noise::NoiseWeights;
@@ -25,9 +26,6 @@ type Matrix7 = SMatrix<f64, 7, 7>;
 
 /// Largest number of Levenberg–Marquardt iterations.
 const MAX_ITERATIONS: usize = 50;
-
-/// Relative decrease of the cost below which the iteration stops.
-const RELATIVE_TOLERANCE: f64 = 1e-12;
 
 /// Turn rate (rad/s) and forward speed (m/s) above which a sample counts as turning
 /// while translating, for the typical speeds of the sentence.
@@ -206,7 +204,7 @@ pub fn fit_lateral_slip(
     ];
     let ne = |x: &[f64; 7]| normal_equations(samples, &used, x, &weights, constraints, use_profile);
     let (mut cost, mut h, mut g) = ne(&x);
-    let mut lambda = 1e-6;
+    let mut damping = Damping::new();
     for _ in 0..MAX_ITERATIONS {
         if !(cost.is_finite() && cost > 0.0) {
             break;
@@ -214,16 +212,15 @@ pub fn fit_lateral_slip(
         let hm = Matrix7::from_fn(|a, b| h[a][b]);
         let (hs, s) = unit_diagonal(&hm);
         let gs = SVector::<f64, 7>::from_fn(|a, _| g[a] * s[a]);
-        let Some(chol) = (hs + Matrix7::identity() * lambda).cholesky() else {
-            lambda *= 10.0;
-            if lambda > 1e12 {
+        let Some(chol) = (hs + Matrix7::identity() * damping.lambda()).cholesky() else {
+            if damping.rejected() {
                 break;
             }
             continue;
         };
         let step = -chol.solve(&gs);
         let predicted = -2.0 * gs.dot(&step) - (hs * step).dot(&step);
-        if predicted <= RELATIVE_TOLERANCE * cost {
+        if Damping::negligible(predicted, cost) {
             break;
         }
         let trial: [f64; 7] = std::array::from_fn(|a| x[a] + step[a] * s[a]);
@@ -231,15 +228,11 @@ pub fn fit_lateral_slip(
         if tc.is_finite() && tc <= cost {
             let decrease = cost - tc;
             (x, cost, h, g) = (trial, tc, th, tg);
-            lambda = (lambda * 0.1).max(1e-12);
-            if decrease <= RELATIVE_TOLERANCE * cost {
+            if damping.accepted(decrease, cost) {
                 break;
             }
-        } else {
-            lambda *= 10.0;
-            if lambda > 1e12 {
-                break;
-            }
+        } else if damping.rejected() {
+            break;
         }
     }
     if !x.iter().all(|v| v.is_finite()) {

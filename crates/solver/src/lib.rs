@@ -50,6 +50,7 @@
 mod calibrate;
 mod constraints;
 mod covariance;
+mod damping;
 mod error;
 mod inflate;
 mod kinematics;

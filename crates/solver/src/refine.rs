@@ -2,6 +2,7 @@
 //! weighted residuals `ŝ_pred − ŝ`, started from the closed form.
 
 use crate::constraints::Constraints;
+use crate::damping::Damping;
 use crate::linalg::unit_diagonal;
 use crate::noise::NoiseWeights;
 use crate::normal_equations::{accumulate, NormalEquations};
@@ -12,9 +13,6 @@ use serde::Serialize;
 
 /// Largest number of Levenberg–Marquardt iterations.
 pub const MAX_ITERATIONS: usize = 100;
-
-/// Relative decrease of the cost below which the iteration stops.
-const RELATIVE_TOLERANCE: f64 = 1e-12;
 
 /// Outcome of the refinement.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -56,7 +54,7 @@ pub(crate) fn refine(
     let mut params = constraints.apply_held(start);
     let mut ne = constrained_normal_equations(samples, &params, weights, constraints);
     let cost_before = ne.cost;
-    let mut lambda = 1e-6;
+    let mut damping = Damping::new();
     let mut iterations = 0;
     let mut converged = false;
     while iterations < MAX_ITERATIONS {
@@ -68,11 +66,10 @@ pub(crate) fn refine(
         // Solve (H + λ diag H) δ = −g in unit-diagonal scaling.
         let h = SMatrix::<f64, 6, 6>::from_fn(|i, j| ne.h[i][j]);
         let (hs, s) = unit_diagonal(&h);
-        let damped = hs + SMatrix::<f64, 6, 6>::identity() * lambda;
+        let damped = hs + SMatrix::<f64, 6, 6>::identity() * damping.lambda();
         let gs = SVector::<f64, 6>::from_fn(|i, _| ne.g[i] * s[i]);
         let Some(chol) = damped.cholesky() else {
-            lambda *= 10.0;
-            if lambda > 1e12 {
+            if damping.rejected() {
                 break;
             }
             continue;
@@ -80,7 +77,7 @@ pub(crate) fn refine(
         let step_scaled = -chol.solve(&gs);
         // Predicted decrease of the quadratic model: −2gᵀδ − δᵀHδ.
         let predicted = -2.0 * gs.dot(&step_scaled) - (hs * step_scaled).dot(&step_scaled);
-        if predicted <= RELATIVE_TOLERANCE * ne.cost {
+        if Damping::negligible(predicted, ne.cost) {
             converged = true;
             break;
         }
@@ -94,17 +91,13 @@ pub(crate) fn refine(
             let decrease = ne.cost - trial_ne.cost;
             params = trial;
             ne = trial_ne;
-            lambda = (lambda * 0.1).max(1e-12);
-            if decrease <= RELATIVE_TOLERANCE * ne.cost {
+            if damping.accepted(decrease, ne.cost) {
                 converged = true;
                 break;
             }
-        } else {
-            lambda *= 10.0;
-            if lambda > 1e12 {
-                converged = true;
-                break;
-            }
+        } else if damping.rejected() {
+            converged = true;
+            break;
         }
     }
     let cost_after = ne.cost;
