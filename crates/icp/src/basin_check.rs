@@ -22,7 +22,7 @@ use crate::{IcpParams, IcpResult, Matcher, PreparedScan};
 use odocal_geom::Pose2;
 
 /// χ²(3)'s 99.7 % level.
-pub(crate) const CHI2_3_997: f64 = 14.16;
+const CHI2_3_997: f64 = 14.16;
 
 /// A result comfortably well conditioned (condition number below this share of
 /// [`IcpParams::max_condition_number`]) is not tested: its cost has a clear bowl in
@@ -34,7 +34,7 @@ const CONVERGENCE_SPREAD: f64 = 3.0;
 
 /// The squared Mahalanobis distance of `d` (x, y, θ) under `cov` (∞ when `cov` is
 /// not invertible).
-pub(crate) fn mahalanobis_sq(d: [f64; 3], cov: &[[f64; 3]; 3]) -> f64 {
+fn mahalanobis_sq(d: [f64; 3], cov: &[[f64; 3]; 3]) -> f64 {
     let m = nalgebra::Matrix3::from_fn(|r, c| cov[r][c]);
     let v = nalgebra::Vector3::from(d);
     match m.try_inverse() {
@@ -48,22 +48,6 @@ pub(crate) fn mahalanobis_sq(d: [f64; 3], cov: &[[f64; 3]; 3]) -> f64 {
         }
         None => f64::INFINITY,
     }
-}
-
-/// The covariance two runs to one minimum differ within: `result`'s, plus the
-/// convergence tolerance — two runs stop anywhere within it, and that much difference
-/// is no flatness (noise-free scans have a covariance of almost nothing).
-pub(crate) fn judged_covariance(result: &IcpResult, params: &IcpParams) -> [[f64; 3]; 3] {
-    let mut judged = result.covariance;
-    let tolerance = [
-        CONVERGENCE_SPREAD * params.epsilon_xy,
-        CONVERGENCE_SPREAD * params.epsilon_xy,
-        CONVERGENCE_SPREAD * params.epsilon_theta,
-    ];
-    for (k, t) in tolerance.iter().enumerate() {
-        judged[k][k] += t * t;
-    }
-    judged
 }
 
 /// `result.pose` moved by `step` (m) along the unit direction `weak` of `(x, y, ρθ)`.
@@ -109,7 +93,18 @@ impl Matcher {
             return result;
         }
         let rho = rms_range(current).max(1e-3);
-        let judged = judged_covariance(&result, params);
+        // Two runs stop anywhere within the convergence tolerance of the same
+        // minimum: that much difference is no flatness (noise-free scans have a
+        // covariance of almost nothing).
+        let mut judged = result.covariance;
+        let tolerance = [
+            CONVERGENCE_SPREAD * params.epsilon_xy,
+            CONVERGENCE_SPREAD * params.epsilon_xy,
+            CONVERGENCE_SPREAD * params.epsilon_theta,
+        ];
+        for (k, t) in tolerance.iter().enumerate() {
+            judged[k][k] += t * t;
+        }
         // Both sides: a wall may stop the iterations on one.
         for sign in [1.0, -1.0] {
             let start = moved(&result.pose, result.weakest_direction, sign * step, rho);

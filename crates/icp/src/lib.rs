@@ -48,10 +48,6 @@
 //!    the matcher starts again from the rotations where the two scans' histograms of
 //!    line directions agree best (translation-independent); two distinct consistent
 //!    results are refused as ambiguous.
-//! 10. `overlap_rescue`: a pair refused for its small overlap is matched again with a
-//!     lower floor, and kept only when the iterations come back to that result from
-//!     starts 2 cm and 1° away (a wrong alignment slid along a wall is one of several
-//!     nearby minima).
 //!
 //! ```no_run
 //! use odocal_icp::{IcpParams, Matcher, PreparedScan};
@@ -73,7 +69,6 @@ mod correspondence;
 mod covariance;
 mod error;
 mod matcher;
-mod overlap_rescue;
 mod params;
 mod preprocess;
 mod range_noise;

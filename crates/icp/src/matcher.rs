@@ -158,31 +158,7 @@ impl Matcher {
     /// directions agree best); the consistent result is returned, an
     /// [`IcpError::Ambiguous`] when two distinct consistent results are found, and the
     /// first attempt's error when none is.
-    ///
-    /// A pair refused for its small overlap gets a second look
-    /// (`overlap_rescue`): it is accepted when its match, with a lower overlap
-    /// floor, is the only minimum around it.
     pub fn match_scans(
-        &mut self,
-        reference: &PreparedScan,
-        current: &PreparedScan,
-        first_guess: Pose2,
-    ) -> Result<IcpResult, IcpError> {
-        match self.match_scans_once(reference, current, first_guess) {
-            Err(refusal @ IcpError::SmallOverlap { .. }) => {
-                self.overlap_rescued(reference, current, first_guess, refusal)
-            }
-            outcome => outcome,
-        }
-    }
-
-    /// Replaces the parameters (the overlap rescue lowers the floor for a while).
-    pub(crate) fn set_params(&mut self, params: IcpParams) {
-        self.params = params;
-    }
-
-    /// [`Matcher::match_scans`] without the second look at a small overlap.
-    pub(crate) fn match_scans_once(
         &mut self,
         reference: &PreparedScan,
         current: &PreparedScan,
