@@ -7,63 +7,28 @@
 //! and result or error; `RATIO`, `SHARE` and `MAXR` override
 //! `max_residual_to_noise`, `min_matched_share` and `max_reading`.
 
-use odocal_geom::Pose2;
 use odocal_icp::IcpParams;
 use odocal_pipeline::matching::match_pairs;
-use odocal_pipeline::sweep::{compensated_pairs, reference_time};
+use odocal_pipeline::sweep::compensated_pairs;
 use odocal_pipeline::sync::{EncoderTrack, SyncLimits};
-use odocal_solver::Params;
 use std::collections::BTreeMap;
+
+mod common;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();
-    if a.len() < 10 {
-        return Err("usage: LOG STRIDE OFFSET r_l r_r b l_x l_y l_theta".into());
-    }
-    let log = odocal_log::read_log(std::path::Path::new(&a[1]), &Default::default())?;
-    let stride: usize = a[2].parse()?;
-    let offset: f64 = a[3].parse()?;
-    let v: Vec<f64> = a[4..10]
-        .iter()
-        .map(|s| s.parse())
-        .collect::<Result<_, _>>()?;
-    let params = Params {
-        r_l: v[0],
-        r_r: v[1],
-        b: v[2],
-        laser: Pose2::new(v[3], v[4], v[5]),
-    };
-    let ticks = log.params.ticks_per_revolution.map_or(2000.0, |t| t.0);
-    let track = EncoderTrack::new(&log.encoders, ticks);
-    let enc_t: Vec<f64> = log.encoders.iter().map(|e| e.t).collect();
-    let times: Vec<f64> = (0..log.scans.len())
-        .map(|i| {
-            log.scans
-                .get(i)
-                .map_or(log.scans.scans[i].t, |s| reference_time(&s))
-        })
-        .collect();
-    let limits = SyncLimits::from_streams(&enc_t, &times, stride);
-    let laser = Pose2::new(v[3], v[4], v[5]);
+    let setup = common::Setup::from_args(&a)?;
+    let (log, stride, offset, params) = (&setup.log, setup.stride, setup.offset, &setup.params);
+    let track = EncoderTrack::new(&log.encoders, setup.ticks);
+    let limits = SyncLimits::from_streams(&setup.encoder_times(), &setup.times, stride);
     let mut pairs = Vec::new();
     let mut guesses = Vec::new();
-    let rpt = track.rad_per_tick();
     for i in 0..log.scans.len().saturating_sub(stride) {
-        let j = i + stride;
-        let (Ok(t0), Ok(t1)) = (
-            track.ticks_at(times[i] - offset, 0.2),
-            track.ticks_at(times[j] - offset, 0.2),
-        ) else {
+        let Some(g) = setup.guess(&track, i, i + stride) else {
             continue;
         };
-        let (sl, sr) = (
-            params.r_l * rpt * (t1.0 - t0.0),
-            params.r_r * rpt * (t1.1 - t0.1),
-        );
-        let (ds, dth) = (0.5 * (sl + sr), (sr - sl) / params.b);
-        let robot = Pose2::new(ds * (0.5 * dth).cos(), ds * (0.5 * dth).sin(), dth);
-        guesses.push(laser.inverse().compose(&robot).compose(&laser));
-        pairs.push((i, j));
+        guesses.push(g);
+        pairs.push((i, i + stride));
     }
     if std::env::var("NOISE").is_ok() {
         let mut n: Vec<f64> = (0..log.scans.len())
@@ -93,7 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             n[n.len() - 1]
         );
     }
-    let (store, _) = compensated_pairs(&log.scans, &pairs, &track, &limits, &params, offset);
+    let (store, _) = compensated_pairs(&log.scans, &pairs, &track, &limits, params, offset);
     let mut icp = IcpParams::default();
     if let Ok(v) = std::env::var("RATIO") {
         icp.max_residual_to_noise = v.parse()?;
