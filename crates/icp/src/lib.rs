@@ -66,6 +66,7 @@
 mod basin_check;
 mod consistency;
 mod correspondence;
+mod cost_envelope;
 mod covariance;
 mod error;
 mod matcher;
