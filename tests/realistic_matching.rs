@@ -416,7 +416,10 @@ fn a_washboard_cost_is_not_called_precise() {
     let run = simulate_in(&config, &world).unwrap();
     let scans: Vec<_> = run.logged_scans().collect();
     let (a, b) = (&scans[96], &scans[99]);
-    let truth = a.sensor_at_reference.inverse().compose(&b.sensor_at_reference);
+    let truth = a
+        .sensor_at_reference
+        .inverse()
+        .compose(&b.sensor_at_reference);
     let laser = &config.laser;
     let realism = laser.realism.expect("a realistic preset");
     let angles = laser.angles();
@@ -455,8 +458,7 @@ fn a_washboard_cost_is_not_called_precise() {
     let n = errors.len();
     assert!(n >= 10, "{n} of 60 draws matched");
     let mean = errors.iter().sum::<f64>() / n as f64;
-    let spread =
-        (errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
+    let spread = (errors.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (n - 1) as f64).sqrt();
     let sigma = (reported.iter().sum::<f64>() / n as f64).sqrt();
     println!(
         "{n} matched: scatter along x {:.1} mm (mean {:.1} mm), reported σ {:.1} mm",
