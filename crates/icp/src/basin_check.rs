@@ -60,7 +60,7 @@ fn moved(pose: &Pose2, weak: [f64; 3], step: f64, rho: f64) -> Pose2 {
 }
 
 /// RMS range of the scan's valid points (m; 0 when none).
-fn rms_range(scan: &PreparedScan) -> f64 {
+pub(crate) fn rms_range(scan: &PreparedScan) -> f64 {
     let n = scan.valid_indices.len().max(1) as f64;
     let sum: f64 = scan
         .valid_indices

@@ -44,10 +44,15 @@
 //!    iterations do not come back (the cost is flat there whatever its curvature with
 //!    the correspondences fixed says), it is flagged `ill_conditioned` and its
 //!    covariance widened.
-//! 9. `rotation_search`: when the attempt from the first guess fails or is refused,
-//!    the matcher starts again from the rotations where the two scans' histograms of
-//!    line directions agree best (translation-independent); two distinct consistent
-//!    results are refused as ambiguous.
+//! 9. `cost_envelope`: a result that is not comfortably well conditioned has its
+//!    cost evaluated ±10σ along its covariance's largest axis with the
+//!    correspondences found again; where that cost rises less than the covariance
+//!    predicts (a washboard: noisy short lines, each shift finds new ones), the
+//!    variance along the axis is widened by the ratio.
+//! 10. `rotation_search`: when the attempt from the first guess fails or is refused,
+//!     the matcher starts again from the rotations where the two scans' histograms
+//!     of line directions agree best (translation-independent); two distinct
+//!     consistent results are refused as ambiguous.
 //!
 //! ```no_run
 //! use odocal_icp::{IcpParams, Matcher, PreparedScan};
@@ -66,6 +71,7 @@
 mod basin_check;
 mod consistency;
 mod correspondence;
+mod cost_envelope;
 mod covariance;
 mod error;
 mod matcher;

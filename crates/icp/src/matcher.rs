@@ -127,6 +127,9 @@ pub struct Matcher {
     ray_residuals: RayResiduals,
     /// Scratch of the covariance's residual noise by range.
     range_bins: RangeBins,
+    /// The cost envelope's fixed correspondences (current point, line normal, offset,
+    /// weight; module `cost_envelope`).
+    fixed_lines: Vec<([f64; 2], [f64; 2], f64, f64)>,
 }
 
 impl Matcher {
@@ -140,6 +143,7 @@ impl Matcher {
             weight_cache: Vec::new(),
             ray_residuals: RayResiduals::default(),
             range_bins: RangeBins::default(),
+            fixed_lines: Vec::new(),
         }
     }
 
@@ -186,14 +190,9 @@ impl Matcher {
             use_tree,
         ) {
             Ok(result) => {
-                return Ok(self.basin_checked(
-                    reference,
-                    current,
-                    result,
-                    first_guess,
-                    &params,
-                    use_tree,
-                ))
+                let result =
+                    self.basin_checked(reference, current, result, first_guess, &params, use_tree);
+                return Ok(self.envelope_widened(reference, current, result, &params, use_tree));
             }
             Err(e) => e,
         };
@@ -240,10 +239,73 @@ impl Matcher {
             Some(result) => {
                 let result =
                     self.basin_checked(reference, current, result, first_guess, &params, use_tree);
+                let result = self.envelope_widened(reference, current, result, &params, use_tree);
                 Ok(IcpResult { starts, ..result })
             }
             None => Err(first_error),
         }
+    }
+
+    /// Keeps the correspondences found at `pose` (current point, line normal, offset,
+    /// weight) as the fixed ones of [`Matcher::truncated_costs`]; returns the
+    /// truncated cost at `pose`.
+    pub(crate) fn fix_correspondences(
+        &mut self,
+        reference: &PreparedScan,
+        current: &PreparedScan,
+        pose: &Pose2,
+        gate2: f64,
+        tau_sq: f64,
+        use_tree: bool,
+    ) -> f64 {
+        self.find_correspondences(reference, current, pose, gate2, use_tree);
+        self.fixed_lines.clear();
+        self.fixed_lines.extend(
+            self.correspondences
+                .iter()
+                .map(|c| (c.q, c.normal, c.offset, c.weight)),
+        );
+        let unmatched = current.valid_indices.len() - self.correspondences.len();
+        self.correspondences
+            .iter()
+            .map(|k| k.normalized_sq.min(tau_sq))
+            .sum::<f64>()
+            + unmatched as f64 * tau_sq
+    }
+
+    /// The truncated cost `Σ min(w e², τ²)` over the valid current points (unmatched
+    /// ones at `τ²`) at `pose`: with the correspondences kept by
+    /// [`Matcher::fix_correspondences`], and with those found at `pose` (module
+    /// `cost_envelope`).
+    pub(crate) fn truncated_costs(
+        &mut self,
+        reference: &PreparedScan,
+        current: &PreparedScan,
+        pose: &Pose2,
+        gate2: f64,
+        tau_sq: f64,
+        use_tree: bool,
+    ) -> (f64, f64) {
+        let n = current.valid_indices.len() as f64;
+        let (s, c) = pose.theta.sin_cos();
+        let fixed: f64 = self
+            .fixed_lines
+            .iter()
+            .map(|&(q, normal, offset, w)| {
+                let p = [pose.x + c * q[0] - s * q[1], pose.y + s * q[0] + c * q[1]];
+                let e = normal[0] * p[0] + normal[1] * p[1] - offset;
+                (w * e * e).min(tau_sq)
+            })
+            .sum::<f64>()
+            + (n - self.fixed_lines.len() as f64) * tau_sq;
+        self.find_correspondences(reference, current, pose, gate2, use_tree);
+        let again: f64 = self
+            .correspondences
+            .iter()
+            .map(|k| k.normalized_sq.min(tau_sq))
+            .sum::<f64>()
+            + (n - self.correspondences.len() as f64) * tau_sq;
+        (fixed, again)
     }
 
     /// The ICP iterations from `start`, the corrections measured from `anchor` (the
