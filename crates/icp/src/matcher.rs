@@ -582,7 +582,7 @@ impl Matcher {
             let Some(seg) = segment_for(reference, p, j) else {
                 continue;
             };
-            let Some(line) = reference.segments[seg] else {
+            let Some(line) = reference.line(seg) else {
                 continue;
             };
             let residual = line.normal[0] * p[0] + line.normal[1] * p[1] - line.offset;

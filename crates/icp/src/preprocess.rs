@@ -9,6 +9,7 @@
 //! rather than to the raw segment, whose direction two noisy points barely fix.
 //! On noise-free straight walls the local line is the wall itself.
 
+use crate::sparse::{is_sparse, isolated_lines, missing_readings, widen_short_runs};
 use crate::{IcpError, IcpParams, NeighbourSearch};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 
@@ -71,8 +72,12 @@ pub struct PreparedScan {
     /// Readings without a return (zero, non-finite or below the minimum range: dark,
     /// glancing or transparent surfaces), as opposed to valid ones and to readings
     /// beyond the maximum range (a far surface was seen); all false in a scan where
-    /// they are rare (see `no_returns`).
+    /// they are rare: in a scan that is not sparse (see [`crate::sparse`]).
     pub(crate) no_return: Vec<bool>,
+    /// `isolated_lines[i]`: in a sparse scan, the line through isolated valid point
+    /// `i` (on no usable segment) and its nearest returns across short gaps without a
+    /// return ([`crate::sparse::isolated_lines`]); empty when the scan is not sparse.
+    pub(crate) isolated_lines: Vec<Option<SegmentLine>>,
     /// Indices of the valid readings, increasing.
     pub(crate) valid_indices: Vec<u32>,
     /// Valid readings on a usable local line (finite `incidence_cos`): the points a
@@ -100,7 +105,7 @@ pub struct PreparedScan {
 
 /// Window statistics of a local line fit.
 #[derive(Clone, Copy)]
-struct WindowFit {
+pub(crate) struct WindowFit {
     /// Centroid, relative to `origin`.
     mx: f64,
     my: f64,
@@ -109,7 +114,7 @@ struct WindowFit {
     sxy: f64,
     syy: f64,
     /// Smallest eigenvalue of the scatter (sum of squared line residuals).
-    smallest: f64,
+    pub(crate) smallest: f64,
     origin: [f64; 2],
 }
 
@@ -180,8 +185,21 @@ impl PreparedScan {
 
         let angles_increasing = angles.windows(2).all(|w| w[1] > w[0]);
         let connected = connections(ranges, angles, &points, &valid, params);
-        let (segments, tilt_noise_scale, noise_sigma) =
+        let (mut segments, tilt_noise_scale, noise_sigma) =
             local_lines(&points, &inv_ranges, &connected, params);
+        let missing = missing_readings(ranges, lo);
+        let sparse = is_sparse(&missing);
+        if sparse {
+            widen_short_runs(
+                &points,
+                angles,
+                &valid,
+                &missing,
+                &connected,
+                &mut segments,
+                params,
+            );
+        }
         let incidence_cos = (0..n)
             .map(|i| {
                 let before = i.checked_sub(1).and_then(|k| segments[k]);
@@ -220,6 +238,19 @@ impl PreparedScan {
                 },
             })
             .collect();
+        let isolated_lines = if sparse {
+            isolated_lines(
+                &points,
+                angles,
+                &valid,
+                &missing,
+                |i| valid[i] && incidence_cos[i].is_nan(),
+                params,
+            )
+        } else {
+            Vec::new()
+        };
+        let no_return = if sparse { missing } else { vec![false; n] };
         let rays = dirs
             .iter()
             .zip(&points)
@@ -237,7 +268,8 @@ impl PreparedScan {
             sides,
             points,
             valid,
-            no_return: no_returns(ranges, lo),
+            no_return,
+            isolated_lines,
             incidence_cos,
             valid_indices,
             lined_count,
@@ -282,6 +314,17 @@ impl PreparedScan {
         (*self.valid.get(i)?).then(|| self.points[i])
     }
 
+    /// The line of segment code `seg` (from `correspondence::segment_for`): below
+    /// the number of readings, the local line of the segment from point `seg` to
+    /// `seg + 1`; from there on, the line of isolated point `seg − len()`.
+    #[inline]
+    pub(crate) fn line(&self, seg: usize) -> Option<SegmentLine> {
+        match seg.checked_sub(self.points.len()) {
+            None => self.segments[seg],
+            Some(j) => self.isolated_lines.get(j).copied().flatten(),
+        }
+    }
+
     /// Index of the ray whose angle is closest to `bearing` (rad, not wrapped).
     pub(crate) fn ray_near_bearing(&self, bearing: f64) -> usize {
         let n = self.angles.len();
@@ -296,27 +339,6 @@ impl PreparedScan {
         }
     }
 }
-
-/// `no_return[i]`: reading `i` is zero, non-finite or at most `lo` (m) — in a scan
-/// where such readings are common (at least [`SPARSE_SCAN_SHARE`] of them: dark or
-/// glancing surfaces, a real URG-04LX on the MinesRover logs has 55 %); elsewhere
-/// none is marked and the matches stay exactly what they were (rare dropouts cost a
-/// point or two; simulated scans with 15–20 % of their rays beyond the range, also
-/// reported as 0, moved a TurtleBot-class verdict from "weak" to "not excited").
-fn no_returns(ranges: &[f32], lo: f64) -> Vec<bool> {
-    let missing: Vec<bool> = ranges
-        .iter()
-        .map(|&r| !r.is_finite() || f64::from(r) <= lo)
-        .collect();
-    let count = missing.iter().filter(|&&m| m).count();
-    if (count as f64) < SPARSE_SCAN_SHARE * ranges.len() as f64 {
-        return vec![false; ranges.len()];
-    }
-    missing
-}
-
-/// See [`no_returns`].
-const SPARSE_SCAN_SHARE: f64 = 0.45;
 
 /// Unit directions of the rays. For uniformly spaced angles (every laser) they are
 /// generated by rotating with the step, re-anchored on an exact `sin_cos` every 32
@@ -549,7 +571,7 @@ fn tilt_scale(ratios: &mut [f64]) -> f64 {
 
 /// Sums of a window's coordinates about an origin, and their products.
 #[derive(Debug, Clone, Copy, Default)]
-struct Moments {
+pub(crate) struct Moments {
     x: f64,
     y: f64,
     xx: f64,
@@ -560,7 +582,7 @@ struct Moments {
 impl Moments {
     /// Adds (`sign` = 1) or removes (`sign` = −1) point `p`.
     #[inline]
-    fn add(&mut self, p: [f64; 2], origin: [f64; 2], sign: f64) {
+    pub(crate) fn add(&mut self, p: [f64; 2], origin: [f64; 2], sign: f64) {
         let (dx, dy) = (p[0] - origin[0], p[1] - origin[1]);
         self.x += sign * dx;
         self.y += sign * dy;
@@ -571,7 +593,7 @@ impl Moments {
 
     /// Centroid, scatter and residual sum of squares of the `count` points summed
     /// (the line itself is computed only for the windows that get used).
-    fn fit(&self, origin: [f64; 2], count: usize) -> WindowFit {
+    pub(crate) fn fit(&self, origin: [f64; 2], count: usize) -> WindowFit {
         let k = count as f64;
         let (mx, my) = (self.x / k, self.y / k);
         let sxx = (self.xx - mx * self.x).max(0.0);
@@ -607,7 +629,7 @@ impl WindowFit {
     /// The line through the centroid along the major axis of the scatter, its normal
     /// pointing towards the sensor. The normal is the eigenvector of the smallest
     /// eigenvalue, from whichever of two equivalent forms is better conditioned.
-    fn line(&self) -> SegmentLine {
+    pub(crate) fn line(&self) -> SegmentLine {
         let (sxx, sxy, syy, smallest) = (self.sxx, self.sxy, self.syy, self.smallest);
         let u = [sxy, smallest - sxx];
         let v = [smallest - syy, sxy];
