@@ -9,7 +9,9 @@
 //! rather than to the raw segment, whose direction two noisy points barely fix.
 //! On noise-free straight walls the local line is the wall itself.
 
-use crate::sparse::{is_sparse, isolated_lines, missing_readings, widen_short_runs};
+use crate::sparse::{
+    is_sparse, isolated_lines, missing_readings, missing_share_is_sparse, widen_short_runs,
+};
 use crate::{IcpError, IcpParams, NeighbourSearch};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 
@@ -72,11 +74,13 @@ pub struct PreparedScan {
     /// Readings without a return (zero, non-finite or below the minimum range: dark,
     /// glancing or transparent surfaces), as opposed to valid ones and to readings
     /// beyond the maximum range (a far surface was seen); all false in a scan where
-    /// they are rare: in a scan that is not sparse (see [`crate::sparse`]).
+    /// they are rare (fewer than 45 %; in the [`PreparedScan::bridged`] form of a
+    /// sparse scan, all of them: see [`crate::sparse`]).
     pub(crate) no_return: Vec<bool>,
-    /// `isolated_lines[i]`: in a sparse scan, the line through isolated valid point
-    /// `i` (on no usable segment) and its nearest returns across short gaps without a
-    /// return ([`crate::sparse::isolated_lines`]); empty when the scan is not sparse.
+    /// `isolated_lines[i]`: in the [`PreparedScan::bridged`] form of a sparse scan, the
+    /// line through isolated valid point `i` (on no usable segment) and its nearest
+    /// returns across short gaps without a return ([`crate::sparse::isolated_lines`]);
+    /// empty elsewhere.
     pub(crate) isolated_lines: Vec<Option<SegmentLine>>,
     /// Indices of the valid readings, increasing.
     pub(crate) valid_indices: Vec<u32>,
@@ -101,6 +105,9 @@ pub struct PreparedScan {
     /// k-d tree over the valid points, built when the k-d search is asked for or the
     /// angles do not allow the angular search.
     pub(crate) tree: Option<PointTree>,
+    /// In a sparse scan ([`crate::sparse`]), the same scan with lines across its short
+    /// gaps without a return: used only for the pairs its own lines fail to match.
+    pub(crate) bridged: Option<Box<PreparedScan>>,
 }
 
 /// Window statistics of a local line fit.
@@ -185,72 +192,17 @@ impl PreparedScan {
 
         let angles_increasing = angles.windows(2).all(|w| w[1] > w[0]);
         let connected = connections(ranges, angles, &points, &valid, params);
-        let (mut segments, tilt_noise_scale, noise_sigma) =
+        let (segments, tilt_noise_scale, noise_sigma) =
             local_lines(&points, &inv_ranges, &connected, params);
         let missing = missing_readings(ranges, lo);
-        let sparse = is_sparse(&missing);
-        if sparse {
-            widen_short_runs(
-                &points,
-                angles,
-                &valid,
-                &missing,
-                &connected,
-                &mut segments,
-                params,
-            );
-        }
-        let incidence_cos = (0..n)
-            .map(|i| {
-                let before = i.checked_sub(1).and_then(|k| segments[k]);
-                match (before, segments[i]) {
-                    (Some(a), Some(b)) => 0.5 * (a.incidence_cos + b.incidence_cos),
-                    (Some(a), None) | (None, Some(a)) => a.incidence_cos,
-                    (None, None) => f64::NAN,
-                }
-            })
-            .collect::<Vec<f64>>();
-        let lined_count = incidence_cos.iter().filter(|c| !c.is_nan()).count();
-        // The direction between consecutive points of a usable segment is, up to its
-        // sign, the tangent of the segment's local line.
-        let unit_towards = |line: &SegmentLine, from: usize, to: usize| {
-            let t = [-line.normal[1], line.normal[0]];
-            let d = [
-                points[to][0] - points[from][0],
-                points[to][1] - points[from][1],
-            ];
-            let sign = if t[0] * d[0] + t[1] * d[1] >= 0.0 {
-                1.0
-            } else {
-                -1.0
-            };
-            [(sign * t[0]) as f32, (sign * t[1]) as f32]
-        };
-        let sides = (0..n)
-            .map(|i| Sides {
-                to_next: match &segments[i] {
-                    Some(line) => unit_towards(line, i, i + 1),
-                    None => [f32::NAN; 2],
-                },
-                to_previous: match i.checked_sub(1).and_then(|k| segments[k].as_ref()) {
-                    Some(line) => unit_towards(line, i, i - 1),
-                    None => [f32::NAN; 2],
-                },
-            })
-            .collect();
-        let isolated_lines = if sparse {
-            isolated_lines(
-                &points,
-                angles,
-                &valid,
-                &missing,
-                |i| valid[i] && incidence_cos[i].is_nan(),
-                params,
-            )
+        // The scan's own lines, the readings without a return followed past only when
+        // they are common: what every pair is matched with first.
+        let (incidence_cos, lined_count, sides) = lined_points(&points, &segments);
+        let no_return = if missing_share_is_sparse(&missing) {
+            missing.clone()
         } else {
-            Vec::new()
+            vec![false; n]
         };
-        let no_return = if sparse { missing } else { vec![false; n] };
         let rays = dirs
             .iter()
             .zip(&points)
@@ -262,14 +214,14 @@ impl PreparedScan {
         } else {
             None
         };
-        Ok(PreparedScan {
+        let mut scan = PreparedScan {
             angles: angles.to_vec(),
             rays,
             sides,
             points,
             valid,
             no_return,
-            isolated_lines,
+            isolated_lines: Vec::new(),
             incidence_cos,
             valid_indices,
             lined_count,
@@ -280,7 +232,67 @@ impl PreparedScan {
             tilt_noise_scale,
             noise_sigma,
             tree,
-        })
+            bridged: None,
+        };
+        if is_sparse(&missing) {
+            scan.bridged = Some(Box::new(
+                scan.with_bridged_lines(angles, &missing, &connected, params),
+            ));
+        }
+        Ok(scan)
+    }
+
+    /// This sparse scan with lines across its short gaps without a return (see
+    /// [`crate::sparse`]): short runs widened, isolated points lined, every reading
+    /// without a return followed past.
+    fn with_bridged_lines(
+        &self,
+        angles: &[f64],
+        missing: &[bool],
+        connected: &[bool],
+        params: &IcpParams,
+    ) -> PreparedScan {
+        let mut segments = self.segments.clone();
+        widen_short_runs(
+            &self.points,
+            angles,
+            &self.valid,
+            missing,
+            connected,
+            &mut segments,
+            params,
+        );
+        let (incidence_cos, lined_count, sides) = lined_points(&self.points, &segments);
+        let isolated_lines = isolated_lines(
+            &self.points,
+            angles,
+            &self.valid,
+            missing,
+            |i| self.valid[i] && incidence_cos[i].is_nan(),
+            params,
+        );
+        PreparedScan {
+            sides,
+            no_return: missing.to_vec(),
+            isolated_lines,
+            incidence_cos,
+            lined_count,
+            segments,
+            bridged: None,
+            ..self.clone()
+        }
+    }
+
+    /// The scan with lines across its short gaps without a return when it is sparse
+    /// (what a pair is matched with again when its scans' own lines fail), else the
+    /// scan itself.
+    pub(crate) fn bridged(&self) -> &PreparedScan {
+        self.bridged.as_deref().unwrap_or(self)
+    }
+
+    /// Whether the scan is sparse and has a [`PreparedScan::bridged`] form.
+    pub(crate) fn has_bridged(&self) -> bool {
+        self.bridged.is_some()
     }
 
     /// Range noise the scan shows about its own local lines (σ, m; `None` when it has
@@ -338,6 +350,55 @@ impl PreparedScan {
             (i as usize).min(n - 1)
         }
     }
+}
+
+/// Per point, from the segments' lines: the incidence |cos| on its own surface (NaN
+/// when on no usable segment), the number of such lined points, and the directions to
+/// its neighbours along usable segments.
+fn lined_points(
+    points: &[[f64; 2]],
+    segments: &[Option<SegmentLine>],
+) -> (Vec<f64>, usize, Vec<Sides>) {
+    let n = points.len();
+    let incidence_cos = (0..n)
+        .map(|i| {
+            let before = i.checked_sub(1).and_then(|k| segments[k]);
+            match (before, segments[i]) {
+                (Some(a), Some(b)) => 0.5 * (a.incidence_cos + b.incidence_cos),
+                (Some(a), None) | (None, Some(a)) => a.incidence_cos,
+                (None, None) => f64::NAN,
+            }
+        })
+        .collect::<Vec<f64>>();
+    let lined_count = incidence_cos.iter().filter(|c| !c.is_nan()).count();
+    // The direction between consecutive points of a usable segment is, up to its
+    // sign, the tangent of the segment's local line.
+    let unit_towards = |line: &SegmentLine, from: usize, to: usize| {
+        let t = [-line.normal[1], line.normal[0]];
+        let d = [
+            points[to][0] - points[from][0],
+            points[to][1] - points[from][1],
+        ];
+        let sign = if t[0] * d[0] + t[1] * d[1] >= 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
+        [(sign * t[0]) as f32, (sign * t[1]) as f32]
+    };
+    let sides = (0..n)
+        .map(|i| Sides {
+            to_next: match &segments[i] {
+                Some(line) => unit_towards(line, i, i + 1),
+                None => [f32::NAN; 2],
+            },
+            to_previous: match i.checked_sub(1).and_then(|k| segments[k].as_ref()) {
+                Some(line) => unit_towards(line, i, i - 1),
+                None => [f32::NAN; 2],
+            },
+        })
+        .collect();
+    (incidence_cos, lined_count, sides)
 }
 
 /// Unit directions of the rays. For uniformly spaced angles (every laser) they are

@@ -26,7 +26,7 @@
 //! beyond the range (open space: long gaps) keep the matches exactly what they were.
 
 use crate::preprocess::{Moments, SegmentLine};
-use crate::IcpParams;
+use crate::{IcpError, IcpParams};
 
 /// Share of readings without a return from which a scan is sparse.
 const SPARSE_SCAN_SHARE: f64 = 0.45;
@@ -42,6 +42,22 @@ pub(crate) const MAX_BRIDGED_GAP: usize = 3;
 /// Returns taken on each side of an isolated point for its line.
 const SIDE_POINTS: usize = 2;
 
+/// Whether a pair whose scans' own lines end in `error` is matched again with the
+/// lines across short gaps: when too few points found a line, too few matched, the
+/// residuals stayed far above the noise or the iterations did not settle (what a
+/// scan fallen apart into short runs does). Not after an ambiguity, a correction too
+/// large or a numerical failure: the lines do not remove their cause, and could only
+/// pick one of several alignments or reach a farther one.
+pub(crate) fn worth_bridging(error: &IcpError) -> bool {
+    matches!(
+        error,
+        IcpError::TooFewCorrespondences { .. }
+            | IcpError::SmallOverlap { .. }
+            | IcpError::ResidualAboveNoise { .. }
+            | IcpError::FailedToConverge { .. }
+    )
+}
+
 /// `missing[i]`: reading `i` got no return (zero, non-finite or at most `lo`, m).
 pub(crate) fn missing_readings(ranges: &[f32], lo: f64) -> Vec<bool> {
     ranges
@@ -53,9 +69,16 @@ pub(crate) fn missing_readings(ranges: &[f32], lo: f64) -> Vec<bool> {
 /// Whether the scan with these readings without a return is sparse (see the module
 /// documentation).
 pub(crate) fn is_sparse(missing: &[bool]) -> bool {
-    let n = missing.len() as f64;
+    missing_share_is_sparse(missing)
+        || scattered(missing) as f64 >= SCATTERED_SHARE * missing.len() as f64
+}
+
+/// Whether readings without a return are common: at least [`SPARSE_SCAN_SHARE`] of
+/// them (the scan's own runs are then followed past their ends at such readings even
+/// in the first match of a pair).
+pub(crate) fn missing_share_is_sparse(missing: &[bool]) -> bool {
     let count = missing.iter().filter(|&&m| m).count();
-    count as f64 >= SPARSE_SCAN_SHARE * n || scattered(missing) as f64 >= SCATTERED_SHARE * n
+    count as f64 >= SPARSE_SCAN_SHARE * missing.len() as f64
 }
 
 /// Readings without a return in gaps of at most [`MAX_BRIDGED_GAP`] between readings
@@ -260,7 +283,46 @@ fn incidence(line: &SegmentLine, p: [f64; 2]) -> f64 {
 mod tests {
     use super::*;
     use crate::correspondence::segment_for;
-    use crate::PreparedScan;
+    use crate::{Matcher, PreparedScan};
+    use odocal_geom::Pose2;
+
+    /// Ranges of 360 rays over a full turn from `pose` in a 5 m × 3.5 m room with a
+    /// 0.6 m square pillar, the rays for which `lost(i)` got no return (0).
+    fn room_scan(pose: Pose2, lost: impl Fn(usize) -> bool) -> PreparedScan {
+        let angles: Vec<f64> = (0..360).map(|i| (i as f64 - 180.0).to_radians()).collect();
+        let boxes = [
+            ([-2.0, -1.5], [3.0, 2.0], true),
+            ([0.8, 0.6], [1.4, 1.2], false),
+        ];
+        let ranges: Vec<f32> = angles
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                if lost(i) {
+                    return 0.0;
+                }
+                let (s, c) = (pose.theta + a).sin_cos();
+                let o = [pose.x, pose.y];
+                let mut best = f64::INFINITY;
+                for (lo, hi, inside) in boxes {
+                    for axis in 0..2 {
+                        let d = if axis == 0 { c } else { s };
+                        for wall in [lo[axis], hi[axis]] {
+                            let t = (wall - o[axis]) / d;
+                            let other = 1 - axis;
+                            let at = o[other] + t * if other == 0 { c } else { s };
+                            let hit = t > 1e-9 && at >= lo[other] && at <= hi[other];
+                            if hit && (inside || t < best) {
+                                best = best.min(t);
+                            }
+                        }
+                    }
+                }
+                best as f32
+            })
+            .collect();
+        PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).expect("scan")
+    }
 
     /// A wall at y = 2 m seen by 181 rays over 90° of which every other one got no
     /// return, and a post (one return) at 1 m in front of it on ray 120.
@@ -298,13 +360,14 @@ mod tests {
 
     #[test]
     fn isolated_points_on_a_surface_get_its_line_and_a_post_does_not() {
-        let scan = wall_every_other_ray();
+        let own = wall_every_other_ray();
+        let scan = own.bridged();
         // No two consecutive returns: no run, no usable segment at all.
         assert_eq!(scan.usable_segment_count(), 0);
         // A point on the wall near the return of ray 90 (x = 0): before, no
         // correspondence (an isolated closest point); now the wall's line.
         let p = [0.004, 2.003];
-        let seg = segment_for(&scan, p, 90).expect("the line across the gaps");
+        let seg = segment_for(scan, p, 90).expect("the line across the gaps");
         assert_eq!(seg, scan.len() + 90);
         let line = scan.line(seg).expect("a line");
         assert!(
@@ -314,7 +377,7 @@ mod tests {
         assert!((line.incidence_cos - 1.0).abs() < 1e-6);
         // The post's return has no neighbour on its surface: no line.
         let post = scan.point(120).expect("the post");
-        assert_eq!(segment_for(&scan, post, 120), None);
+        assert_eq!(segment_for(scan, post, 120), None);
     }
 
     #[test]
@@ -334,8 +397,8 @@ mod tests {
             .collect();
         let scan =
             PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).expect("scan");
-        assert!(scan.isolated_lines.is_empty());
-        assert_eq!(segment_for(&scan, [0.004, 2.003], 90), None);
+        assert!(!scan.has_bridged() && scan.bridged().isolated_lines.is_empty());
+        assert_eq!(segment_for(scan.bridged(), [0.004, 2.003], 90), None);
     }
 
     #[test]
@@ -359,9 +422,94 @@ mod tests {
             PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).expect("scan");
         // The pair at rays 90, 91 (x ≈ 0): its segment's line is the wall's within 3°
         // (the line through the pair and two returns on each side).
-        let line = scan.segments[90].expect("a line");
+        let line = scan.bridged().segments[90].expect("a line");
         let tilt = line.normal[0].atan2(-line.normal[1]).to_degrees();
         assert!(tilt.abs() < 3.0, "tilt {tilt}°: {line:?}");
         assert!((line.offset + 2.0).abs() < 0.005, "{line:?}");
+    }
+
+    #[test]
+    fn a_sparse_scans_own_lines_stay_its_runs_and_the_bridged_ones_are_apart() {
+        // The scan of `short_runs_of_a_sparse_scan_take_the_line_across_the_gaps`: 33 %
+        // of its readings missing, all in single gaps (sparse by the scattered share
+        // only).
+        let angles: Vec<f64> = (0..181)
+            .map(|i| (45.0 + i as f64 * 0.5).to_radians())
+            .collect();
+        let ranges: Vec<f32> = angles
+            .iter()
+            .enumerate()
+            .map(|(i, a)| match i % 3 {
+                0 => (2.0 / a.sin() + 0.006) as f32,
+                1 => (2.0 / a.sin() - 0.006) as f32,
+                _ => 0.0,
+            })
+            .collect();
+        let scan =
+            PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).expect("scan");
+        assert!(scan.has_bridged());
+        // The scan's own segment at rays 90, 91 is the pair's chord (tilted ≈ 33°), and
+        // its readings without a return are not followed past (fewer than 45 %): the
+        // first match of a pair sees the scan as it did before the lines existed.
+        let own = scan.segments[90].expect("the pair's segment");
+        let tilt = own.normal[0].atan2(-own.normal[1]).to_degrees();
+        assert!(tilt.abs() > 20.0, "tilt {tilt}°: {own:?}");
+        assert!(scan.no_return.iter().all(|&m| !m));
+        assert!(scan.isolated_lines.is_empty());
+        // The bridged form has the wall's line and follows every missing reading.
+        let bridged = scan.bridged();
+        let line = bridged.segments[90].expect("a line");
+        assert!(line.normal[0].atan2(-line.normal[1]).to_degrees().abs() < 3.0);
+        assert!(bridged.no_return[92]);
+    }
+
+    #[test]
+    fn a_pair_its_own_lines_match_keeps_that_match() {
+        // A room seen with 1 reading in 12 lost (sparse: scattered dropouts): the own
+        // lines match it (73 % of the points), so the bridged lines (85 %, and a pose
+        // 3e-9 m apart) must not move the result at all.
+        let reference = room_scan(Pose2::new(0.0, 0.0, 0.0), |i| i % 12 == 11);
+        let truth = Pose2::new(0.12, -0.05, 0.04);
+        let current = room_scan(truth, |i| (i + 3) % 12 == 11);
+        assert!(reference.has_bridged() && current.has_bridged());
+        let mut matcher = Matcher::new(IcpParams::default());
+        let guess = Pose2::new(0.1, -0.04, 0.03);
+        let got = matcher
+            .match_scans(&reference, &current, guess)
+            .expect("a match");
+        let strip = |s: &PreparedScan| PreparedScan {
+            bridged: None,
+            ..s.clone()
+        };
+        let own = matcher
+            .match_prepared(&strip(&reference), &strip(&current), guess)
+            .expect("a match with the own lines");
+        assert_eq!(got.pose, own.pose);
+        assert_eq!(got.correspondences, own.correspondences);
+    }
+
+    #[test]
+    fn a_pair_its_own_lines_cannot_match_is_matched_across_the_gaps() {
+        // Every other reading lost: no two consecutive returns, no run, no segment of
+        // its own; the lines across the gaps match the pair within 5 mm / 0.3°.
+        let reference = room_scan(Pose2::new(0.0, 0.0, 0.0), |i| i % 2 == 1);
+        let truth = Pose2::new(0.12, -0.05, 0.04);
+        let current = room_scan(truth, |i| i % 2 == 0);
+        let mut matcher = Matcher::new(IcpParams::default());
+        let guess = Pose2::new(0.1, -0.04, 0.03);
+        let own = matcher.match_prepared(&reference, &current, guess);
+        assert!(
+            matches!(own, Err(IcpError::TooFewCorrespondences { .. })),
+            "{own:?}"
+        );
+        let got = matcher
+            .match_scans(&reference, &current, guess)
+            .expect("a match across the gaps");
+        let error = truth.between(&got.pose);
+        assert!(
+            error.translation_norm() < 0.005 && error.theta.abs() < 0.3f64.to_radians(),
+            "{:?} against {truth:?}",
+            got.pose
+        );
     }
 }
