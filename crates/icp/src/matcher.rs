@@ -160,10 +160,10 @@ impl Matcher {
     /// [`IcpError::Ambiguous`] when two distinct consistent results are found, and the
     /// first attempt's error when none is.
     ///
-    /// When either scan is sparse and its own lines fail to match the pair (see
-    /// [`crate::sparse::worth_bridging`]), the pair is matched again with lines across
-    /// the scans' short gaps without a return; a pair its own lines match keeps that
-    /// result.
+    /// When either scan is sparse and its own lines explain too small a share of the
+    /// current scan ([`IcpError::SmallOverlap`]), the pair is matched again with lines
+    /// across the scans' short gaps without a return, and that error is returned if
+    /// this fails too; a pair its own lines match keeps that result.
     pub fn match_scans(
         &mut self,
         reference: &PreparedScan,

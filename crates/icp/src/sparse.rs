@@ -7,7 +7,9 @@
 //! ends. A scan is **sparse** when readings without a return are common (at least
 //! [`SPARSE_SCAN_SHARE`] of them) or scattered along the surfaces (at least
 //! [`SCATTERED_SHARE`] of the readings in gaps of at most [`MAX_BRIDGED_GAP`]
-//! between returns); in a sparse scan
+//! between returns). A sparse scan is prepared with its own lines as any scan (runs
+//! followed a little past an end at a reading without a return only when such
+//! readings are common) and also in a *bridged* form (`PreparedScan::bridged`) where
 //! - a run that ends at a reading without a return is followed a little past its end
 //!   (`correspondence::segment_for`),
 //! - an isolated point (on no usable segment) gets the line through it and its nearest
@@ -17,13 +19,19 @@
 //!   direction poorly, and such chance directions also make a featureless pair look
 //!   well conditioned.
 //!
-//! Measured on the realistic presets (120 s, seeds 1–3, docs/benchmarks.md): pairs
-//! with a true overlap of at least half matched 92 → 98 % (mines-rover), 37 → 38 %
-//! (neato-lds), 68 → 97 % (turtlebot4-rplidar), and fewer accepted matches beyond
-//! 5 mm / 0.5° of the truth on each (254 → 226, 223 → 155, 144 → 106).
+//! A pair is matched with the bridged forms only when its own lines explain too small
+//! a share of the current scan ([`worth_bridging`]); a pair they match keeps that
+//! result. Used on every pair of a sparse scan, the bridged lines moved matches that
+//! were right (the simulated Pioneer's scans are sparse, and its calibrations then
+//! disagreed beyond their σ in the fast-robot Monte Carlo). Measured on the realistic
+//! presets (120 s, seeds 1–3, docs/benchmarks.md): pairs with a true overlap of at
+//! least half matched 88 → 93 % (mines-rover), 28 → 30 % (neato-lds), 57 → 84 %
+//! (turtlebot4-rplidar); of the accepted matches, about as large a share as before is
+//! beyond 5 mm / 0.5° of the truth (31, 57, 14 %; 30, 57, 16 % before).
 //!
-//! Elsewhere nothing changes: the simulator's rare dropouts (0.1 %) and readings
-//! beyond the range (open space: long gaps) keep the matches exactly what they were.
+//! Elsewhere nothing changes: scans that are not sparse have no bridged form, and the
+//! simulator's rare dropouts (0.1 %) and readings beyond the range (open space: long
+//! gaps) do not make a scan sparse.
 
 use crate::preprocess::{Moments, SegmentLine};
 use crate::{IcpError, IcpParams};
