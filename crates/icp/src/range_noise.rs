@@ -46,14 +46,20 @@ impl RangeBins {
     /// residual, the squared robust spread of its range bin.
     pub fn variances(&mut self) -> &[f64] {
         let m = self.ranges.len().min(self.squared.len());
-        let ranges = &self.ranges;
         self.order.clear();
         self.order.extend(0..m as u32);
-        self.order
-            .sort_unstable_by(|&a, &b| ranges[a as usize].total_cmp(&ranges[b as usize]));
         self.variance.clear();
         self.variance.resize(m, 0.0);
         let bins = (m / MIN_PER_BIN).clamp(1, MAX_BINS);
+        if !split_into_bins(&mut self.order, &self.ranges, bins) {
+            // A tie straddles a bin boundary: which of the tied members goes where is
+            // what the full sort decides (kept, so that the numbers stay the same).
+            let ranges = &self.ranges;
+            self.order.clear();
+            self.order.extend(0..m as u32);
+            self.order
+                .sort_unstable_by(|&a, &b| ranges[a as usize].total_cmp(&ranges[b as usize]));
+        }
         for b in 0..bins {
             let members = &self.order[b * m / bins..(b + 1) * m / bins];
             self.scratch.clear();
@@ -68,9 +74,70 @@ impl RangeBins {
     }
 }
 
+/// Reorders `order` (indices into `ranges`, in increasing order) so that each of the
+/// `bins` slices `order[b·m/bins .. (b+1)·m/bins]` holds the members of range bin `b`
+/// (in any order: a bin's spread does not depend on it), by one selection per bin
+/// boundary instead of a full sort. The bins are the full sort's whenever no range
+/// value straddles a boundary; false (and `order` to be sorted) when one does.
+fn split_into_bins(order: &mut [u32], ranges: &[f64], bins: usize) -> bool {
+    let m = order.len();
+    let range = |k: u32| ranges[k as usize];
+    let mut start = 0;
+    for b in 1..bins {
+        let boundary = b * m / bins;
+        if boundary <= start || boundary >= m {
+            continue;
+        }
+        let (below, first_above, _) = order[start..]
+            .select_nth_unstable_by(boundary - start, |&a, &b| range(a).total_cmp(&range(b)));
+        let last_below = below.iter().map(|&k| range(k)).max_by(f64::total_cmp);
+        if last_below.is_some_and(|r| r.total_cmp(&range(*first_above)).is_eq()) {
+            return false;
+        }
+        start = boundary;
+    }
+    true
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// `RangeBins::variances` as it was with a full sort of the correspondences.
+    fn variances_by_full_sort(ranges: &[f64], squared: &[f64]) -> Vec<f64> {
+        let m = ranges.len();
+        let mut order: Vec<u32> = (0..m as u32).collect();
+        order.sort_unstable_by(|&a, &b| ranges[a as usize].total_cmp(&ranges[b as usize]));
+        let mut variance = vec![0.0; m];
+        let bins = (m / MIN_PER_BIN).clamp(1, MAX_BINS);
+        for b in 0..bins {
+            let members = &order[b * m / bins..(b + 1) * m / bins];
+            let mut scratch: Vec<f64> = members.iter().map(|&k| squared[k as usize]).collect();
+            let spread = robust_spread(&mut scratch);
+            for &k in members {
+                variance[k as usize] = spread * spread;
+            }
+        }
+        variance
+    }
+
+    proptest! {
+        /// Bit for bit the variances of the full sort, ties across bin boundaries
+        /// included (few distinct ranges: many ties).
+        #[test]
+        fn variances_are_those_of_a_full_sort(
+            pairs in prop::collection::vec((0u16..400, 0u32..1000), 0..700),
+        ) {
+            let mut bins = RangeBins::default();
+            for &(r, e) in &pairs {
+                bins.push(f64::from(r) * 0.01, f64::from(e) * 1e-7);
+            }
+            let want = variances_by_full_sort(&bins.ranges, &bins.squared);
+            let got = bins.variances().to_vec();
+            prop_assert_eq!(got, want);
+        }
+    }
 
     #[test]
     fn far_noisy_points_get_their_own_variance() {
