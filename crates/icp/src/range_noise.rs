@@ -25,6 +25,7 @@ pub(crate) struct RangeBins {
     /// Squared weighted residual of each correspondence.
     pub squared: Vec<f64>,
     order: Vec<u32>,
+    keys: Vec<i64>,
     scratch: Vec<f64>,
     variance: Vec<f64>,
 }
@@ -46,20 +47,20 @@ impl RangeBins {
     /// residual, the squared robust spread of its range bin.
     pub fn variances(&mut self) -> &[f64] {
         let m = self.ranges.len().min(self.squared.len());
+        // The sort compares integer keys that order as `f64::total_cmp` orders the
+        // ranges: the same comparisons, hence the same order (ties included), as
+        // comparing the ranges themselves, without converting both at every one.
+        self.keys.clear();
+        self.keys
+            .extend(self.ranges[..m].iter().map(|&r| total_order_key(r)));
+        let keys = &self.keys;
         self.order.clear();
         self.order.extend(0..m as u32);
+        self.order
+            .sort_unstable_by(|&a, &b| keys[a as usize].cmp(&keys[b as usize]));
         self.variance.clear();
         self.variance.resize(m, 0.0);
         let bins = (m / MIN_PER_BIN).clamp(1, MAX_BINS);
-        if !split_into_bins(&mut self.order, &self.ranges, bins) {
-            // A tie straddles a bin boundary: which of the tied members goes where is
-            // what the full sort decides (kept, so that the numbers stay the same).
-            let ranges = &self.ranges;
-            self.order.clear();
-            self.order.extend(0..m as u32);
-            self.order
-                .sort_unstable_by(|&a, &b| ranges[a as usize].total_cmp(&ranges[b as usize]));
-        }
         for b in 0..bins {
             let members = &self.order[b * m / bins..(b + 1) * m / bins];
             self.scratch.clear();
@@ -74,38 +75,21 @@ impl RangeBins {
     }
 }
 
-/// Reorders `order` (indices into `ranges`, in increasing order) so that each of the
-/// `bins` slices `order[b·m/bins .. (b+1)·m/bins]` holds the members of range bin `b`
-/// (in any order: a bin's spread does not depend on it), by one selection per bin
-/// boundary instead of a full sort. The bins are the full sort's whenever no range
-/// value straddles a boundary; false (and `order` to be sorted) when one does.
-fn split_into_bins(order: &mut [u32], ranges: &[f64], bins: usize) -> bool {
-    let m = order.len();
-    let range = |k: u32| ranges[k as usize];
-    let mut start = 0;
-    for b in 1..bins {
-        let boundary = b * m / bins;
-        if boundary <= start || boundary >= m {
-            continue;
-        }
-        let (below, first_above, _) = order[start..]
-            .select_nth_unstable_by(boundary - start, |&a, &b| range(a).total_cmp(&range(b)));
-        let last_below = below.iter().map(|&k| range(k)).max_by(f64::total_cmp);
-        if last_below.is_some_and(|r| r.total_cmp(&range(*first_above)).is_eq()) {
-            return false;
-        }
-        start = boundary;
-    }
-    true
+/// An integer that orders as `f64::total_cmp` orders `x` (its bits, with the
+/// magnitude bits of negative numbers flipped: the transformation `total_cmp` makes).
+fn total_order_key(x: f64) -> i64 {
+    let bits = x.to_bits() as i64;
+    bits ^ ((((bits >> 63) as u64) >> 1) as i64)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::consistency::robust_spread;
     use proptest::prelude::*;
 
-    /// `RangeBins::variances` as it was with a full sort of the correspondences.
-    fn variances_by_full_sort(ranges: &[f64], squared: &[f64]) -> Vec<f64> {
+    /// `RangeBins::variances` as it was, sorting by comparing the ranges themselves.
+    fn variances_by_range_sort(ranges: &[f64], squared: &[f64]) -> Vec<f64> {
         let m = ranges.len();
         let mut order: Vec<u32> = (0..m as u32).collect();
         order.sort_unstable_by(|&a, &b| ranges[a as usize].total_cmp(&ranges[b as usize]));
@@ -123,19 +107,36 @@ mod tests {
     }
 
     proptest! {
-        /// Bit for bit the variances of the full sort, ties across bin boundaries
-        /// included (few distinct ranges: many ties).
+        /// Bit for bit the variances of the sort by range, with many ties (few
+        /// distinct ranges, as from a laser reporting millimetres) across the bin
+        /// boundaries, and negative zeros, infinities and NaNs among the ranges.
         #[test]
-        fn variances_are_those_of_a_full_sort(
+        fn variances_are_those_of_the_sort_by_range(
             pairs in prop::collection::vec((0u16..400, 0u32..1000), 0..700),
+            odd in prop::collection::vec(
+                prop::sample::select(vec![-0.0, 0.0, f64::INFINITY, f64::NAN, -1.0]),
+                0..5,
+            ),
         ) {
             let mut bins = RangeBins::default();
             for &(r, e) in &pairs {
                 bins.push(f64::from(r) * 0.01, f64::from(e) * 1e-7);
             }
-            let want = variances_by_full_sort(&bins.ranges, &bins.squared);
+            for &r in &odd {
+                bins.push(r, 1e-6);
+            }
+            let want = variances_by_range_sort(&bins.ranges, &bins.squared);
             let got = bins.variances().to_vec();
-            prop_assert_eq!(got, want);
+            // Compared as bits: NaN spreads must match too.
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+            prop_assert_eq!(bits(&got), bits(&want));
+        }
+
+        /// The keys order as `f64::total_cmp` does, on any bit patterns.
+        #[test]
+        fn keys_order_as_total_cmp(a in any::<u64>(), b in any::<u64>()) {
+            let (x, y) = (f64::from_bits(a), f64::from_bits(b));
+            prop_assert_eq!(total_order_key(x).cmp(&total_order_key(y)), x.total_cmp(&y));
         }
     }
 
