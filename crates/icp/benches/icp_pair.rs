@@ -1,6 +1,7 @@
 //! Time per 681-ray URG-04LX pair: preparing a scan, and matching a prepared pair,
 //! with the angular search and with the kiddo k-d tree. Pairs are consecutive 10 Hz
-//! scans of the simulated Khepera arena (crates/sim), first guess off by ~2 mm / 0.3°.
+//! scans of the simulated Khepera arena, office and realistic MinesRover (sparse
+//! returns, millimetre ranges; crates/sim), first guess off by ~2 mm / 0.3°.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use odocal_geom::Pose2;
@@ -26,7 +27,11 @@ fn guesses(run: &SimRun) -> Vec<Pose2> {
 }
 
 fn bench(c: &mut Criterion) {
-    for (world, preset) in [("arena", "khepera"), ("office", "office")] {
+    for (world, preset) in [
+        ("arena", "khepera"),
+        ("office", "office"),
+        ("rover", "mines-rover"),
+    ] {
         let run = sim(preset);
         let angles = run.config.laser.angles();
         let guesses = guesses(&run);

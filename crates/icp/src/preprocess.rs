@@ -527,12 +527,24 @@ fn local_lines(
                 cos * cos / (fits[s - start].sxx + fits[s - start].syy - fits[s - start].smallest)
             };
             let mut s = start;
+            // The second window's line and tilt unit of one pair are the first
+            // window's of the next: computed once.
+            let mut carried: Option<(usize, SegmentLine, f64)> = None;
             while s + 2 * w <= end + 1 {
                 let (fa, fb) = (&fits[s - start], &fits[s + w - start]);
                 if fa.smallest <= max_smallest && fb.smallest <= max_smallest {
-                    let (la, lb) = (fa.line(), fb.line());
+                    let (la, unit_a) = match carried {
+                        Some((at, line, unit)) if at == s => (line, unit),
+                        _ => {
+                            let line = fa.line();
+                            (line, tilt_unit(s, &line))
+                        }
+                    };
+                    let lb = fb.line();
+                    let unit_b = tilt_unit(s + w, &lb);
+                    carried = Some((s + w, lb, unit_b));
                     let cross = la.normal[0] * lb.normal[1] - la.normal[1] * lb.normal[0];
-                    let units = tilt_unit(s, &la) + tilt_unit(s + w, &lb);
+                    let units = unit_a + unit_b;
                     if units.is_finite() && units > 0.0 {
                         tilt_ratios.push(cross * cross / units);
                     }

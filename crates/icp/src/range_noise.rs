@@ -25,6 +25,7 @@ pub(crate) struct RangeBins {
     /// Squared weighted residual of each correspondence.
     pub squared: Vec<f64>,
     order: Vec<u32>,
+    keys: Vec<i64>,
     scratch: Vec<f64>,
     variance: Vec<f64>,
 }
@@ -46,11 +47,17 @@ impl RangeBins {
     /// residual, the squared robust spread of its range bin.
     pub fn variances(&mut self) -> &[f64] {
         let m = self.ranges.len().min(self.squared.len());
-        let ranges = &self.ranges;
+        // The sort compares integer keys that order as `f64::total_cmp` orders the
+        // ranges: the same comparisons, hence the same order (ties included), as
+        // comparing the ranges themselves, without converting both at every one.
+        self.keys.clear();
+        self.keys
+            .extend(self.ranges[..m].iter().map(|&r| total_order_key(r)));
+        let keys = &self.keys;
         self.order.clear();
         self.order.extend(0..m as u32);
         self.order
-            .sort_unstable_by(|&a, &b| ranges[a as usize].total_cmp(&ranges[b as usize]));
+            .sort_unstable_by(|&a, &b| keys[a as usize].cmp(&keys[b as usize]));
         self.variance.clear();
         self.variance.resize(m, 0.0);
         let bins = (m / MIN_PER_BIN).clamp(1, MAX_BINS);
@@ -68,9 +75,70 @@ impl RangeBins {
     }
 }
 
+/// An integer that orders as `f64::total_cmp` orders `x` (its bits, with the
+/// magnitude bits of negative numbers flipped: the transformation `total_cmp` makes).
+fn total_order_key(x: f64) -> i64 {
+    let bits = x.to_bits() as i64;
+    bits ^ ((((bits >> 63) as u64) >> 1) as i64)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::consistency::robust_spread;
+    use proptest::prelude::*;
+
+    /// `RangeBins::variances` as it was, sorting by comparing the ranges themselves.
+    fn variances_by_range_sort(ranges: &[f64], squared: &[f64]) -> Vec<f64> {
+        let m = ranges.len();
+        let mut order: Vec<u32> = (0..m as u32).collect();
+        order.sort_unstable_by(|&a, &b| ranges[a as usize].total_cmp(&ranges[b as usize]));
+        let mut variance = vec![0.0; m];
+        let bins = (m / MIN_PER_BIN).clamp(1, MAX_BINS);
+        for b in 0..bins {
+            let members = &order[b * m / bins..(b + 1) * m / bins];
+            let mut scratch: Vec<f64> = members.iter().map(|&k| squared[k as usize]).collect();
+            let spread = robust_spread(&mut scratch);
+            for &k in members {
+                variance[k as usize] = spread * spread;
+            }
+        }
+        variance
+    }
+
+    proptest! {
+        /// Bit for bit the variances of the sort by range, with many ties (few
+        /// distinct ranges, as from a laser reporting millimetres) across the bin
+        /// boundaries, and negative zeros, infinities and NaNs among the ranges.
+        #[test]
+        fn variances_are_those_of_the_sort_by_range(
+            pairs in prop::collection::vec((0u16..400, 0u32..1000), 0..700),
+            odd in prop::collection::vec(
+                prop::sample::select(vec![-0.0, 0.0, f64::INFINITY, f64::NAN, -1.0]),
+                0..5,
+            ),
+        ) {
+            let mut bins = RangeBins::default();
+            for &(r, e) in &pairs {
+                bins.push(f64::from(r) * 0.01, f64::from(e) * 1e-7);
+            }
+            for &r in &odd {
+                bins.push(r, 1e-6);
+            }
+            let want = variances_by_range_sort(&bins.ranges, &bins.squared);
+            let got = bins.variances().to_vec();
+            // Compared as bits: NaN spreads must match too.
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
+            prop_assert_eq!(bits(&got), bits(&want));
+        }
+
+        /// The keys order as `f64::total_cmp` does, on any bit patterns.
+        #[test]
+        fn keys_order_as_total_cmp(a in any::<u64>(), b in any::<u64>()) {
+            let (x, y) = (f64::from_bits(a), f64::from_bits(b));
+            prop_assert_eq!(total_order_key(x).cmp(&total_order_key(y)), x.total_cmp(&y));
+        }
+    }
 
     #[test]
     fn far_noisy_points_get_their_own_variance() {
