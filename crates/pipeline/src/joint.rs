@@ -157,7 +157,7 @@ pub fn calibrate_logs_with_lasers(
             discarded: synced.discarded,
         }));
     }
-    let solve_options = opts.solve_options();
+    let solve_options = crate::matcher_bias::with_matcher_bias(opts.solve_options(), &synced);
     let laser_of: Vec<usize> = outcomes
         .iter()
         .zip(&laser_of_log)
