@@ -98,7 +98,9 @@ fn khepera_sigma_is_consistent() {
 fn robot_classes_sigma() {
     // Measured (docs/benchmarks.md): TurtleBot class 0.76–0.98, Pioneer class
     // 0.99–1.14 (40 fresh seeds 6301–6340: 0.93–1.17 and 0.98–1.22; independent
-    // model: 0.39–0.62); the issue's band as for the Khepera.
+    // model: 0.39–0.62); with the matcher-bias term (issue 20) 0.82–0.97 and
+    // 0.87–1.23 (scaled by the range noise alone, the term made the TurtleBot's b,
+    // ℓx, ℓy 0.47, 0.39, 0.36). The issue's band as for the Khepera.
     for preset in ["turtlebot", "pioneer"] {
         let r = rms(preset, &errors_in_sigma(preset, 6101..6121));
         for i in 0..6 {
@@ -137,4 +139,69 @@ fn short_logs_are_not_overconfident() {
     );
     assert!(beyond < 0.03, "{:.1} % beyond 3σ", 100.0 * beyond);
     assert!(all.iter().all(|z| z.abs() < 5.0), "{all:?}");
+}
+
+/// Per seed: (estimate − truth)/σ for the six parameters on a two-minute log of a
+/// realistic preset, σ with the laser's range scale (`sigma_total`, what the error
+/// against the truth is compared with); `None` for a seed the pipeline refuses
+/// (printed with its reason).
+fn realistic_errors_in_sigma(preset: &str, seeds: std::ops::Range<u64>) -> Vec<[f64; 6]> {
+    seeds
+        .filter_map(|seed| {
+            let mut config = SimConfig::preset(preset).expect("preset exists");
+            config.seed = seed;
+            config.duration = 120.0;
+            let run = simulate(&config).expect("simulation runs");
+            let opts = Options {
+                accept_weak: true,
+                ..Options::default()
+            };
+            let out = match calibrate_log(&run.to_log(), &opts, &NoProgress) {
+                Ok(out) => out,
+                Err(e) => {
+                    println!("{preset} seed {seed}: refused ({e})");
+                    return None;
+                }
+            };
+            let est = odocal_pipeline::Estimate::of(&out);
+            let r = &run.config.robot;
+            let truth = [r.r_l, r.r_r, r.b, r.laser.x, r.laser.y, r.laser.theta];
+            Some(std::array::from_fn(|i| {
+                (est.params[i] - truth[i]) / est.sigma_total[i]
+            }))
+        })
+        .collect()
+}
+
+#[test]
+#[ignore = "Monte Carlo, 12 two-minute logs of each realistic preset (≈ 1 min); the issue's target, not met yet (see the comment)"]
+fn realistic_presets_sigma() {
+    // The issue's band, 0.7–1.3, for every parameter of every realistic preset.
+    // Measured (docs/benchmarks.md, "σ on the realistic presets"; seeds 101–112):
+    // this fails today. mines-rover r_L, r_R, b 1.37–1.39 (a +1.5 % bias, the same
+    // on every seed: the simulated URG-04LX's range error 3 mm + 4 mm/m²·r², whose
+    // slope at the rover's ranges exceeds the data sheet's 1 % range-scale σ), ℓx
+    // 1.42 (the slide), ℓθ 2.19 (seed 111 at −6.55σ; 1.15 without it); neato-lds
+    // ℓx 0.60, ℓθ 0.49 on the 7 seeds it calibrates (5 refused: every match fails);
+    // turtlebot4-rplidar ℓx 0.68.
+    let mut failures = Vec::new();
+    for preset in ["mines-rover", "neato-lds", "turtlebot4-rplidar"] {
+        let runs = realistic_errors_in_sigma(preset, 101..113);
+        let labelled: Vec<([f64; 6], bool)> = runs.iter().map(|z| (*z, true)).collect();
+        let r = rms(preset, &labelled);
+        assert!(
+            runs.len() >= 5,
+            "{preset}: only {} seeds calibrated",
+            runs.len()
+        );
+        for i in 0..6 {
+            if !(0.7..1.3).contains(&r[i]) {
+                failures.push(format!("{preset} {}: {:.2}", NAMES[i], r[i]));
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "RMS error/σ outside 0.7–1.3: {failures:?}"
+    );
 }

@@ -76,12 +76,13 @@ fn reproduce(row: &PublishedRow, samples: usize, seed: u64) -> Reproduction {
         .unwrap_or_else(|e| panic!("row {}: the pipeline fails: {e}", row.name))
 }
 
-/// Runs every row, prints the side-by-side tables, and asserts the rules.
-fn check_rows(samples_of: impl Fn(&PublishedRow) -> usize, tol: &Tolerances) {
+/// Runs every row, prints the side-by-side tables, asserts the rules, and returns
+/// the reproductions.
+fn check_rows(samples_of: impl Fn(&PublishedRow) -> usize, tol: &Tolerances) -> Vec<Reproduction> {
     let rows = published_rows();
     if rows.is_empty() {
         println!("notice: no published rows available; nothing to reproduce");
-        return;
+        return Vec::new();
     }
     let mut reps = Vec::new();
     let mut failures = Vec::new();
@@ -93,6 +94,7 @@ fn check_rows(samples_of: impl Fn(&PublishedRow) -> usize, tol: &Tolerances) {
     }
     println!("{}", format_summary(&reps, tol));
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+    reps
 }
 
 #[test]
@@ -122,7 +124,25 @@ fn full_size_rows_meet_every_bound() {
         sigma_multiple: FAMILY_SIGMAS,
         ..Tolerances::default()
     };
-    check_rows(|row| row.samples as usize, &tol);
+    let reps = check_rows(|row| row.samples as usize, &tol);
+    // Issue 20's target for the table itself: at most one row beyond its per-quantity
+    // 3σ rule (seed 1). Before the matcher-bias term five rows were (six checks: the
+    // matcher's rotation bias, common to every sample, as large as σ at full size);
+    // with it one, k28 ℓθ at 3.36σ. With honest σ, two or more rows of 22 fail by
+    // chance with probability ≈ 8 %: a change that trips this alone deserves a look
+    // over seeds (`three_sigma_rule_holds_over_seeds`), not a new seed.
+    let three_sigma = Tolerances::default();
+    let beyond: Vec<String> = reps
+        .iter()
+        .filter(|r| !r.failures(&three_sigma).is_empty())
+        .map(|r| r.failures(&three_sigma).join("; "))
+        .collect();
+    assert!(
+        beyond.len() <= 1,
+        "{} rows beyond 3σ: {}",
+        beyond.len(),
+        beyond.join("\n")
+    );
 }
 
 #[test]
@@ -165,8 +185,9 @@ fn three_sigma_rule_holds_over_seeds() {
         100.0 * beyond2 as f64 / checks as f64,
         100.0 * beyond3 as f64 / checks as f64
     );
-    // Issue 13's band for honest σ (measured 1.07 with the shared-scan σ model; 0.54
-    // with the independent-samples model before it).
+    // Issue 13's band for honest σ (measured 1.07 with the shared-scan σ model, 1.04
+    // with the matcher-bias term of issue 20 (5.1 % beyond 2σ, 0.5 % beyond 3σ); 0.54
+    // with the independent-samples model before them).
     assert!(
         rms < 1.3,
         "errors are {rms:.2}σ RMS: the covariance is too small"

@@ -50,11 +50,33 @@ pub struct Args {
     /// `final` (final estimate and samples; tighter when outliers survive round 1).
     #[arg(long, value_enum, default_value = "first-round")]
     pub sigma: SigmaFrom,
+    /// The scan matcher's bias on rotations as a systematic part of σ: standard
+    /// deviations "X,Y,THETA" of a bias β·θ common to every ŝ (m/rad, m/rad, rad/rad).
+    /// `calibrate` derives it from the log's range noise and ray spacing
+    /// (`match_self_check` in results.json; `odocal_pipeline::matcher_bias`); a tuple
+    /// file does not hold them, so by default there is none here.
+    #[arg(long, value_name = "X,Y,THETA", value_parser = parse_matcher_bias)]
+    pub matcher_bias: Option<[f64; 3]>,
     #[command(flatten)]
     pub partial: PartialArgs,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `"X,Y,THETA"` as three finite non-negative numbers.
+fn parse_matcher_bias(text: &str) -> Result<[f64; 3], String> {
+    let values: Vec<f64> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("expected three numbers X,Y,THETA: {e}"))?;
+    match values[..] {
+        [x, y, t] if values.iter().all(|v| v.is_finite() && *v >= 0.0) => Ok([x, y, t]),
+        _ => Err(format!(
+            "expected three finite non-negative numbers X,Y,THETA, got {text:?}"
+        )),
+    }
 }
 
 /// A tuple record as a solver sample.
@@ -122,6 +144,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         },
         constraints: args.partial.constraints()?,
         accept_weak: args.partial.accept_weak,
+        matcher_bias: args.matcher_bias.unwrap_or([0.0; 3]),
         ..SolveOptions::default()
     };
     let cal = calibrate(&samples, &options)

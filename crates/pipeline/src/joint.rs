@@ -157,7 +157,7 @@ pub fn calibrate_logs_with_lasers(
             discarded: synced.discarded,
         }));
     }
-    let solve_options = opts.solve_options();
+    let solve_options = crate::matcher_bias::with_matcher_bias(opts.solve_options(), &synced);
     let laser_of: Vec<usize> = outcomes
         .iter()
         .zip(&laser_of_log)
@@ -405,12 +405,15 @@ fn pooled_self_check(outcomes: &[Outcome]) -> Option<MatchSelfCheck> {
     };
     let mut noise: Vec<f64> = checks.iter().map(|c| c.range_noise_m).collect();
     noise.sort_by(f64::total_cmp);
+    let mut spacing: Vec<f64> = checks.iter().map(|c| c.ray_spacing_rad).collect();
+    spacing.sort_by(f64::total_cmp);
     Some(MatchSelfCheck {
         triples,
         tried: checks.iter().map(|c| c.tried).sum(),
         xy_m: mean_square(|c| c.xy_m),
         theta_rad: mean_square(|c| c.theta_rad),
         range_noise_m: noise[noise.len() / 2],
+        ray_spacing_rad: spacing[spacing.len() / 2],
         sigma_factor: 1.0,
     })
 }

@@ -44,6 +44,7 @@ pub mod lasers;
 pub mod lateral_slip;
 pub mod log_agreement;
 pub mod match_quality;
+pub mod matcher_bias;
 pub mod matching;
 pub mod options;
 pub mod parallel;

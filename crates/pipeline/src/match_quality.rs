@@ -185,6 +185,7 @@ mod tests {
             xy_m,
             theta_rad,
             range_noise_m: 0.001,
+            ray_spacing_rad: 0.006,
             sigma_factor: 1.0,
         }
     }

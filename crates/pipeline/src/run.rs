@@ -389,7 +389,7 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
             ..s.to_solver(opts.use_profile, opts.use_icp_covariance)
         })
         .collect();
-    let solve_options = opts.solve_options();
+    let solve_options = crate::matcher_bias::with_matcher_bias(opts.solve_options(), synced);
     let mut calibration = odocal_solver::calibrate(&samples, &solve_options)?;
     crate::lateral_slip::check_and_apply(
         &mut calibration,

@@ -34,6 +34,10 @@ pub struct MatchSelfCheck {
     pub theta_rad: f64,
     /// The median range noise of the log's scans (m), for scale.
     pub range_noise_m: f64,
+    /// The angle between neighbouring rays of the log's scans (rad; 0 when unknown):
+    /// with the range noise it sets the local lines' tilt noise
+    /// ([`crate::matcher_bias`]).
+    pub ray_spacing_rad: f64,
     /// The factor by which this error multiplied the solver's σ (1: the noise model
     /// already covered it; see [`crate::match_quality::sigma_inflation`]).
     pub sigma_factor: f64,
@@ -86,6 +90,9 @@ pub fn closure_check(
         xy_m: (sum_xy / (2.0 * 3.0 * n_f)).sqrt(),
         theta_rad: (sum_theta / (3.0 * n_f)).sqrt(),
         range_noise_m,
+        ray_spacing_rad: scans
+            .get(pairs[0].0)
+            .map_or(0.0, |s| s.geometry.resolution.abs()),
         sigma_factor: 1.0,
     })
 }

@@ -5,6 +5,7 @@ use crate::constraints::{Constraint, Constraints};
 use crate::covariance::{invert_information, Inversion};
 use crate::error::SolveError;
 use crate::kinematics::{residual_of, Predictor, RawOdometry};
+use crate::matcher_bias::bias_covariance;
 use crate::noise::{residual_sigmas, NoiseWeights};
 use crate::observability::{
     information_not_excited, null_direction_names, parameter_reports, sentence, step1_not_excited,
@@ -77,6 +78,11 @@ pub struct SolveOptions {
     /// excited (σ beyond the verdict's limit); by default that is an error. A
     /// singular information matrix is an error regardless.
     pub accept_weak: bool,
+    /// Standard deviations of a scan-matching bias common to every sample and
+    /// proportional to its rotation (`ŝ` moved by `β·θ`; x, y in m/rad, θ in
+    /// rad/rad, sensor frame), added to the covariance as a systematic term (see
+    /// `matcher_bias.rs`). Default zero: none.
+    pub matcher_bias: [f64; 3],
 }
 
 /// Which residuals `ŝ_pred − ŝ` the scan-matching standard deviations are estimated
@@ -103,6 +109,7 @@ impl Default for SolveOptions {
             sigma_from: SigmaEstimate::FirstRound,
             constraints: Constraints::default(),
             accept_weak: false,
+            matcher_bias: [0.0; 3],
         }
     }
 }
@@ -448,10 +455,15 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     let (covariance, shared_scan_noise) = match invert_information(&information) {
         Inversion::Covariance(c) => {
             let inverse = zero_held_rows(*c, &constraints);
-            match score_covariance(&active, &params, &weights, &inverse) {
+            let bias = bias_covariance(&active, &params, &weights, &inverse, options.matcher_bias);
+            let (random, model) = match score_covariance(&active, &params, &weights, &inverse) {
                 Some((score, model)) => (sandwich(&inverse, &score, &constraints), Some(model)),
                 None => (inverse, None),
-            }
+            };
+            (
+                std::array::from_fn(|i| std::array::from_fn(|j| random[i][j] + bias[i][j])),
+                model,
+            )
         }
         Inversion::Singular(null) => {
             return Err(information_not_excited(

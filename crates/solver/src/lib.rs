@@ -57,6 +57,7 @@ mod kinematics;
 mod lasers;
 mod lateral_slip;
 mod linalg;
+mod matcher_bias;
 mod noise;
 mod normal_equations;
 mod observability;

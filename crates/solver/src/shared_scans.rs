@@ -108,7 +108,7 @@ fn nearest_psd(m: &Matrix3<f64>) -> Matrix3<f64> {
     eig.eigenvectors * Matrix3::from_diagonal(&clamped) * eig.eigenvectors.transpose()
 }
 
-fn weight(weights: &NoiseWeights, index: usize) -> Matrix3<f64> {
+pub(crate) fn weight(weights: &NoiseWeights, index: usize) -> Matrix3<f64> {
     match weights {
         NoiseWeights::Shared(w) => Matrix3::from_diagonal(&Vector3::new(w[0], w[1], w[2])),
         NoiseWeights::PerSample(info) => Matrix3::from_fn(|i, j| info[index][i][j]),
