@@ -169,6 +169,9 @@ impl Matcher {
         if !first_guess.is_finite() {
             return Err(IcpError::NonFiniteGuess(first_guess));
         }
+        if crate::sparse_fallback::applies(reference, current, &params) {
+            return crate::sparse_fallback::match_sparse(reference, current, first_guess, &params);
+        }
         let use_tree = params.search == NeighbourSearch::KdTree || !reference.angles_increasing;
         if use_tree && reference.tree.is_none() {
             return Err(IcpError::InvalidParams(
