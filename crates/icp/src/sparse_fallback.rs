@@ -30,16 +30,16 @@ use crate::solve_step::NormalEquations;
 use crate::{IcpError, IcpParams, IcpResult, PreparedScan};
 use odocal_geom::{wrap_angle, Pose2};
 
-/// The coarse search: 4 cm and 2° steps, 12 cm gate.
+/// The coarse search: 6 cm and 3° steps, 15 cm gate.
 const COARSE: Level = Level {
-    step_xy: 0.04,
-    step_theta: 0.035,
-    gate: 0.12,
+    step_xy: 0.06,
+    step_theta: 0.052,
+    gate: 0.15,
 };
-/// The fine search around each coarse candidate: 1 cm and 0.3° steps, 5 cm gate.
+/// The fine search around each coarse candidate: 1.5 cm and 0.5° steps, 5 cm gate.
 const FINE: Level = Level {
-    step_xy: 0.01,
-    step_theta: 0.005,
+    step_xy: 0.015,
+    step_theta: 0.0087,
     gate: 0.05,
 };
 /// Coarse candidates sharpened, and fine ones iterated from.
@@ -82,8 +82,8 @@ const MIN_MATCHED_SHARE: f64 = 0.5;
 const MAX_SIGMA_XY: f64 = 0.003;
 /// … or in rotation (rad) says too little to be used: it is flagged ill-conditioned.
 /// Sparse pairs are the ones where few points decide a direction. On the `neato-lds`
-/// preset (120 s, seeds 1–3) bounds of 2 mm / 0.2° kept 65 matches (3 beyond 5 mm /
-/// 0.5° of the truth), these 140 (14 beyond).
+/// preset (120 s, seeds 1–3, coarse search 4 cm / 2°) bounds of 2 mm / 0.2° kept 65
+/// matches (3 beyond 5 mm / 0.5° of the truth), these 140 (14 beyond).
 const MAX_SIGMA_THETA: f64 = 0.3 * std::f64::consts::PI / 180.0;
 
 /// Is the covariance `cov` (x, y, θ) too wide for the match to be used (see
