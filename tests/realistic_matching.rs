@@ -311,9 +311,10 @@ fn mines_rover_matches_without_wrong_matches() {
     check("mines-rover", 0.45);
 }
 
-/// Today's matcher matches none of the Neato's sparse scans (too few correspondences,
-/// residuals above its noise test), so it accepts no wrong one either: the share
-/// asserted is 0 until the matcher work lands; a wrong match accepted fails.
+/// The Neato's sparse scans go to the sparse matcher (docs/realistic-presets.md): on
+/// this 20 s log (the robot along a wall) nearly every pair is refused as
+/// ill-conditioned or ambiguous (the primary path matched none of them either), and
+/// none may be accepted beyond 5 mm / 0.5°; the share asserted is 0.
 #[test]
 fn neato_lds_matches_without_wrong_matches() {
     check("neato-lds", 0.0);
@@ -493,6 +494,9 @@ fn turtlebot4_covariances_cover_most_errors() {
 fn realistic_presets_match_table() {
     println!("{TABLE_HEADER}");
     for preset in REALISTIC_PRESETS {
+        if std::env::var("ZZ_PRESET").is_ok_and(|p| p != preset) {
+            continue;
+        }
         let total = print_rows(preset, &[1, 2, 3], 120.0);
         println!("{}", total.row(&format!("**{preset}, 3 seeds**")));
     }

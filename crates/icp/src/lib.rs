@@ -56,6 +56,15 @@
 //!     the matcher starts again from the rotations where the two scans' histograms
 //!     of line directions agree best (translation-independent); two distinct
 //!     consistent results are refused as ambiguous.
+//! 11. `sparse_fallback`: a pair where a scan's rays are coarse (≥ 0.7° apart) and
+//!     its returns few (fewer than [`IcpParams::sparse_below_returns`] per full turn:
+//!     a 1° LDS with most readings missing) is matched instead by a correlative grid
+//!     search over `(x, y, θ)` (`correlative`, on the `nearest_grid` lookup table)
+//!     followed by the exact point-to-line step against lines fitted over each
+//!     reference point's nearest neighbours (`neighbourhood_lines`), whichever rays
+//!     they come from. Distinct results that explain the scans about equally well
+//!     are refused as ambiguous; a result whose σ exceeds 3 mm / 0.3° is flagged
+//!     ill-conditioned.
 //!
 //! ```no_run
 //! use odocal_icp::{IcpParams, Matcher, PreparedScan};
@@ -73,17 +82,21 @@
 
 mod basin_check;
 mod consistency;
+mod correlative;
 mod correspondence;
 mod cost_envelope;
 mod covariance;
 mod error;
 mod matcher;
+mod nearest_grid;
+mod neighbourhood_lines;
 mod params;
 mod preprocess;
 mod range_noise;
 mod rotation_search;
 mod solve_step;
 mod sparse;
+mod sparse_fallback;
 mod trimming;
 
 pub use error::IcpError;

@@ -176,7 +176,13 @@ impl Matcher {
     ) -> Result<IcpResult, IcpError> {
         let own = self.match_prepared(reference, current, first_guess);
         match own {
-            Err(e) if worth_bridging(&e) && (reference.has_bridged() || current.has_bridged()) => {
+            // Pairs the sparse fallback matched do not use the scans' lines: the
+            // bridged forms would give it the same points again.
+            Err(e)
+                if worth_bridging(&e)
+                    && (reference.has_bridged() || current.has_bridged())
+                    && !crate::sparse_fallback::applies(reference, current, &self.params) =>
+            {
                 self.match_prepared(reference.bridged(), current.bridged(), first_guess)
                     .map_err(|_| e)
             }
@@ -195,6 +201,9 @@ impl Matcher {
         params.validate()?;
         if !first_guess.is_finite() {
             return Err(IcpError::NonFiniteGuess(first_guess));
+        }
+        if crate::sparse_fallback::applies(reference, current, &params) {
+            return crate::sparse_fallback::match_sparse(reference, current, first_guess, &params);
         }
         let use_tree = params.search == NeighbourSearch::KdTree || !reference.angles_increasing;
         if use_tree && reference.tree.is_none() {

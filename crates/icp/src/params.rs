@@ -115,6 +115,12 @@ pub struct IcpParams {
     /// TurtleBot 4 (noise growing with range, clutter) such results were 10–100 mm
     /// off with a reported σ of 1–3 mm. 0 disables the test.
     pub basin_check_step: f64,
+    /// A pair where either scan has fewer valid readings per full turn of its field of
+    /// view (a 240° scan's count times 1.5) than this is matched by the
+    /// sparse matcher (a correlative search, then point-to-line iterations against
+    /// lines through metric neighbourhoods; see the crate documentation) instead of
+    /// the primary path, whose local lines need runs of consecutive returns. 0: never.
+    pub sparse_below_returns: usize,
 }
 
 impl Default for IcpParams {
@@ -150,6 +156,7 @@ impl Default for IcpParams {
             min_matched_share: 0.7,
             rotation_hypotheses: 3,
             basin_check_step: 0.02,
+            sparse_below_returns: 160,
         }
     }
 }

@@ -1,0 +1,614 @@
+//! The matcher of very sparse scans (a 1° LDS with 40–140 returns of 361): a
+//! correlative grid search for the basin, then point-to-line iterations against lines
+//! fitted over metric neighbourhoods of the reference points.
+//!
+//! The primary path's local lines come from windows of consecutive rays; on such scans
+//! most windows straddle missing readings, and a ray 1° from its neighbour at 3 m is
+//! 5 cm away, so the few lines left are poor and the iterations — even started at the
+//! true pose — end 20–55 mm off on half the pairs with a σ of 3 mm. Here:
+//! 1. `neighbourhood_lines`: a line per reference point through the reference points
+//!    within a few ray spacings of it, kept where it is a line at the scan's own noise.
+//! 2. `correlative`: every pose within the correction window is scored on a coarse
+//!    grid; the best few distinct ones are sharpened on a fine grid.
+//! 3. From each, the exact point-to-line step of `solve_step` is iterated with the
+//!    current points matched to their nearest reference point's line (within the
+//!    extent of its neighbourhood) and a gate shrinking to a few σ of the noise.
+//! 4. Two distinct results that explain the scans about equally well are refused as
+//!    ambiguous; a result is refused when its residuals are far above the noise or it
+//!    explains too little of the current scan (`consistency`), and flagged
+//!    ill-conditioned as on the primary path. The covariance is the primary path's
+//!    sandwich with the noise by range and the residual autocorrelation
+//!    (`covariance`, `range_noise`).
+
+use crate::consistency::{check_consistency, robust_spread};
+use crate::correlative::{search, Candidate, Level};
+use crate::covariance::{InformationSum, RayResiduals};
+use crate::nearest_grid::NearestGrid;
+use crate::neighbourhood_lines::{NeighbourhoodLine, NeighbourhoodLines};
+use crate::range_noise::RangeBins;
+use crate::solve_step::NormalEquations;
+use crate::{IcpError, IcpParams, IcpResult, PreparedScan};
+use odocal_geom::{wrap_angle, Pose2};
+
+/// The coarse search: 6 cm and 3° steps, 15 cm gate.
+const COARSE: Level = Level {
+    step_xy: 0.06,
+    step_theta: 0.052,
+    gate: 0.15,
+};
+/// The fine search around each coarse candidate: 1.5 cm and 0.5° steps, 5 cm gate.
+const FINE: Level = Level {
+    step_xy: 0.015,
+    step_theta: 0.0087,
+    gate: 0.05,
+};
+/// Coarse candidates sharpened, and fine ones iterated from.
+const CANDIDATES: usize = 3;
+/// Two candidates closer than this (m, rad) are one.
+const DISTINCT: (f64, f64) = (0.08, 0.06);
+/// Grid cell of the nearest-point lookup (m).
+const CELL: f64 = 0.02;
+/// Iterations with the fine search's gate; after them the gate is this many σ of the
+/// noise.
+const WIDE_ITERATIONS: u32 = 3;
+const GATE_SIGMAS: f64 = 4.0;
+/// From `settle_after` iterations on, steps moving the points by less than this
+/// share of the noise end the iterations.
+const SETTLE_NOISE_SHARE: f64 = 0.1;
+/// Matches that come back with steps below this (m, rad): converged (a cycle).
+const CYCLE_XY: f64 = 1e-4;
+const CYCLE_THETA: f64 = 1e-4;
+
+/// A current point may match a line this far beyond its neighbourhood's extent (m).
+const LINE_OVERHANG: f64 = 0.03;
+/// Two consistent results farther apart than this (m, rad) are different alignments …
+const AMBIGUOUS_APART: (f64, f64) = (0.02, 0.0175);
+/// … and the pair is ambiguous unless the best one's cost is lower by at least this
+/// (a log-likelihood ratio of 8: the evidence of two clean points' worth).
+const AMBIGUITY_MARGIN: f64 = 16.0;
+/// The cost of a result: `Σ min((e/σ)², COST_CAP²)` over the current points, an
+/// unmatched point costing `COST_CAP²` (σ: the scans' noise).
+const COST_CAP: f64 = 3.0;
+/// Share of the current scan's points a right match explains at least: the pairs
+/// the matcher is for overlap by half a scan or more (the primary path asks 70 %,
+/// which the sparse scans' clutter and missing returns rarely reach).
+const MIN_MATCHED_SHARE: f64 = 0.5;
+
+/// A sparse match whose standard deviation exceeds this in translation (m) …
+const MAX_SIGMA_XY: f64 = 0.003;
+/// … or in rotation (rad) says too little to be used: it is flagged ill-conditioned.
+/// Sparse pairs are the ones where few points decide a direction. On the `neato-lds`
+/// preset (120 s, seeds 1–3, coarse search 4 cm / 2°) bounds of 2 mm / 0.2° kept 65
+/// matches (3 beyond 5 mm / 0.5° of the truth), these 140 (14 beyond); with the
+/// 6 cm / 3° search kept, 133 (13 beyond, 3 of them outside their covariance's 99.7 %).
+const MAX_SIGMA_THETA: f64 = 0.3 * std::f64::consts::PI / 180.0;
+
+/// The Cauchy weight of a residual `e` with scale `sigma`.
+fn cauchy(e: f64, sigma: f64) -> f64 {
+    1.0 / (1.0 + (e / (2.0 * sigma)).powi(2))
+}
+
+/// Is the covariance `cov` (x, y, θ) too wide for the match to be used (see
+/// [`MAX_SIGMA_XY`])? NaN is.
+fn too_uncertain(cov: &[[f64; 3]; 3]) -> bool {
+    !((cov[0][0] + cov[1][1]).sqrt() <= MAX_SIGMA_XY && cov[2][2].sqrt() <= MAX_SIGMA_THETA)
+}
+
+/// Rays at least this far apart (rad) make a coarse scan: the primary path's windows
+/// of consecutive rays span more than 4° there.
+const COARSE_RAY_STEP: f64 = 0.7 * std::f64::consts::PI / 180.0;
+
+/// Should the pair be matched by [`match_sparse`]: the rays are coarse (at least
+/// [`COARSE_RAY_STEP`] apart) and one of the scans has fewer valid readings per full
+/// turn than [`IcpParams::sparse_below_returns`].
+pub(crate) fn applies(
+    reference: &PreparedScan,
+    current: &PreparedScan,
+    params: &IcpParams,
+) -> bool {
+    let limit = params.sparse_below_returns as f64;
+    let sparse = |s: &PreparedScan| ray_step(s) >= COARSE_RAY_STEP && returns_per_turn(s) < limit;
+    sparse(reference) || sparse(current)
+}
+
+/// The valid readings of `scan` per full turn of its field of view: a 240° laser with
+/// 136 returns has 204 per turn, a 360° one with 80 returns 80.
+fn returns_per_turn(scan: &PreparedScan) -> f64 {
+    let span = (ray_step(scan) * scan.angles.len() as f64).clamp(1e-3, std::f64::consts::TAU);
+    scan.valid_count() as f64 * std::f64::consts::TAU / span
+}
+
+/// The valid points of a scan and their ray indices.
+fn valid_points(scan: &PreparedScan) -> (Vec<[f64; 2]>, Vec<usize>) {
+    let rays: Vec<usize> = scan.valid_indices.iter().map(|&i| i as usize).collect();
+    (rays.iter().map(|&i| scan.points[i]).collect(), rays)
+}
+
+/// The angle between neighbouring rays (rad).
+fn ray_step(scan: &PreparedScan) -> f64 {
+    match scan.uniform {
+        Some((_, step)) => step.abs(),
+        None => {
+            let n = scan.angles.len().max(2) as f64;
+            let span = scan.angles.last().unwrap_or(&0.0) - scan.angles.first().unwrap_or(&0.0);
+            span.abs() / (n - 1.0)
+        }
+    }
+}
+
+/// One correspondence of the iterations.
+#[derive(Debug, Clone, Copy)]
+struct Match {
+    /// Index of the current point among the valid ones.
+    point: usize,
+    line: NeighbourhoodLine,
+    /// Residual at the pose it was found at (m).
+    residual: f64,
+}
+
+/// The sparse pair's data shared by every start.
+struct Pair<'a> {
+    reference: Vec<[f64; 2]>,
+    lines: Vec<Option<NeighbourhoodLine>>,
+    current: Vec<[f64; 2]>,
+    current_rays: Vec<usize>,
+    current_scan: &'a PreparedScan,
+    noise: f64,
+    /// RMS range of the current points (m).
+    rms_range: f64,
+    grid: NearestGrid,
+}
+
+impl Pair<'_> {
+    /// The correspondences at `pose` within `gate` (m).
+    fn matches(&self, pose: &Pose2, gate: f64, out: &mut Vec<Match>) {
+        out.clear();
+        for (k, q) in self.current.iter().enumerate() {
+            let p = pose.transform_point(*q);
+            let Some(j) = self.grid.nearest(p) else {
+                continue;
+            };
+            let Some(line) = self.lines[j] else { continue };
+            let along = (p[0] - line.centroid[0]) * -line.normal[1]
+                + (p[1] - line.centroid[1]) * line.normal[0];
+            if along.abs() > line.half_length + LINE_OVERHANG {
+                continue;
+            }
+            let residual = line.normal[0] * p[0] + line.normal[1] * p[1] - line.offset;
+            if residual.abs() <= gate {
+                out.push(Match {
+                    point: k,
+                    line,
+                    residual,
+                });
+            }
+        }
+    }
+
+    /// The point-to-line iterations from `start`; `anchor` is the caller's guess.
+    /// The first iterations use the fine search's gate, the others a fixed gate of a
+    /// few σ of the noise, so that the set of matches settles; residuals are weighted
+    /// by a Cauchy kernel of scale σ (smooth, unlike a hard threshold).
+    fn refine(
+        &self,
+        start: Pose2,
+        anchor: &Pose2,
+        params: &IcpParams,
+    ) -> Result<Refined, IcpError> {
+        let mut pose = start;
+        let mut matches = Vec::new();
+        let mut history = [0u64; 8];
+        let mut converged = false;
+        let mut iterations = 0;
+        let mut last_step = (f64::NAN, f64::NAN);
+        let gate = |iteration: u32| {
+            if iteration <= WIDE_ITERATIONS {
+                FINE.gate
+            } else {
+                (GATE_SIGMAS * self.noise).min(FINE.gate)
+            }
+        };
+        while iterations < params.max_iterations {
+            iterations += 1;
+            self.matches(&pose, gate(iterations), &mut matches);
+            if matches.len() < params.min_correspondences {
+                return Err(IcpError::TooFewCorrespondences {
+                    found: matches.len(),
+                    needed: params.min_correspondences,
+                    iteration: iterations,
+                });
+            }
+            let mut equations = NormalEquations::new();
+            let mut fingerprint = 0xcbf2_9ce4_8422_2325u64;
+            for m in &matches {
+                let w = cauchy(m.residual, self.noise);
+                equations.add(self.current[m.point], m.line.normal, m.line.offset, w);
+                fingerprint = (fingerprint ^ (m.point as u64 | (m.line.offset.to_bits() << 16)))
+                    .wrapping_mul(0x0000_0100_0000_01b3);
+            }
+            let next = equations.solve(&pose).ok_or(IcpError::Numerical {
+                iteration: iterations,
+                what: "singular or non-finite point-to-line step (sparse scans)",
+            })?;
+            let step = pose.between(&next);
+            last_step = (step.translation_norm(), step.theta.abs());
+            pose = next;
+            let small = last_step.0 <= params.epsilon_xy && last_step.1 <= params.epsilon_theta;
+            // Matches flipping between neighbouring lines (whose offsets differ by
+            // their noise) move the estimate back and forth: settled once the steps
+            // move the points by a small fraction of the noise.
+            let settle = (SETTLE_NOISE_SHARE * self.noise).max(params.settle_xy);
+            let settled = iterations >= params.settle_after
+                && last_step.0 <= settle
+                && last_step.1 * self.rms_range <= settle;
+            // The same matches as a few iterations ago: the weights change little,
+            // the iterations cycle about the minimum.
+            let cycling = iterations > WIDE_ITERATIONS
+                && history.contains(&fingerprint)
+                && last_step.0 <= CYCLE_XY
+                && last_step.1 <= CYCLE_THETA;
+            if iterations > WIDE_ITERATIONS && (small || settled || cycling) {
+                converged = true;
+                break;
+            }
+            history[iterations as usize % history.len()] = fingerprint;
+        }
+        let correction = anchor.between(&pose);
+        let (linear, angular) = (
+            correction.translation_norm(),
+            wrap_angle(correction.theta).abs(),
+        );
+        if linear > params.max_linear_correction || angular > params.max_angular_correction {
+            return Err(IcpError::CorrectionTooLarge {
+                linear,
+                angular,
+                max_linear: params.max_linear_correction,
+                max_angular: params.max_angular_correction,
+            });
+        }
+        if !converged {
+            return Err(IcpError::FailedToConverge {
+                iterations,
+                last_step_xy: last_step.0,
+                last_step_theta: last_step.1,
+            });
+        }
+        self.result(pose, gate(iterations), iterations, params)
+    }
+
+    /// The result at `pose`: covariance, consistency.
+    fn result(
+        &self,
+        pose: Pose2,
+        gate: f64,
+        iterations: u32,
+        params: &IcpParams,
+    ) -> Result<Refined, IcpError> {
+        let mut matches = Vec::new();
+        // Every correspondence within the fine gate, for the spread (trimmed or not).
+        self.matches(&pose, FINE.gate, &mut matches);
+        let mut squared: Vec<f64> = matches.iter().map(|m| m.residual * m.residual).collect();
+        let residual_spread = robust_spread(&mut squared);
+        let mut bins = RangeBins::default();
+        for m in &matches {
+            let q = self.current[m.point];
+            bins.push(q[0].hypot(q[1]), m.residual * m.residual);
+        }
+        let variances = bins.variances().to_vec();
+        let mut rays = RayResiduals::default();
+        let mut info = InformationSum::new(&pose, self.current_scan.len(), &mut rays);
+        let mut sum_abs = 0.0;
+        // Truncated χ²: every current point costs at most COST_CAP², matched or not.
+        let mut cost = (self.current.len() - matches.len()) as f64 * COST_CAP * COST_CAP;
+        for (m, v) in matches.iter().zip(variances) {
+            cost += (m.residual / self.noise).powi(2).min(COST_CAP * COST_CAP);
+            if m.residual.abs() > gate {
+                continue;
+            }
+            sum_abs += m.residual.abs();
+            info.add(
+                self.current_rays[m.point],
+                self.current[m.point],
+                m.line.normal,
+                m.residual,
+                1.0,
+                v,
+            );
+        }
+        let used = info.count();
+        if used < params.min_correspondences {
+            return Err(IcpError::TooFewCorrespondences {
+                found: used,
+                needed: params.min_correspondences,
+                iteration: iterations,
+            });
+        }
+        let unc = info.finish().ok_or(IcpError::Numerical {
+            iteration: iterations,
+            what: "non-finite information matrix (sparse scans)",
+        })?;
+        let result = IcpResult {
+            pose,
+            covariance: unc.covariance,
+            iterations,
+            correspondences: used,
+            mean_residual: sum_abs / used.max(1) as f64,
+            residual_sigma: unc.residual_sigma,
+            residual_correlation_inflation: unc.inflation,
+            condition_number: unc.condition_number,
+            ill_conditioned: unc.condition_number.is_nan()
+                || unc.condition_number > params.max_condition_number
+                || too_uncertain(&unc.covariance),
+            weakest_direction: unc.weakest_direction,
+            residual_spread,
+            noise_sigma: self.noise,
+            matched_share: used as f64 / self.current.len().max(1) as f64,
+            starts: 1,
+        };
+        let sparse = IcpParams {
+            min_matched_share: params.min_matched_share.min(MIN_MATCHED_SHARE),
+            ..params.clone()
+        };
+        check_consistency(&result, &sparse)?;
+        Ok(Refined { result, cost })
+    }
+}
+
+/// A consistent result and how well it explains the scans.
+struct Refined {
+    result: IcpResult,
+    /// Truncated χ² of the current points' residuals (see [`COST_CAP`]).
+    cost: f64,
+}
+
+/// ŝ for a pair of sparse scans from `first_guess` (see the module documentation).
+pub(crate) fn match_sparse(
+    reference: &PreparedScan,
+    current: &PreparedScan,
+    first_guess: Pose2,
+    params: &IcpParams,
+) -> Result<IcpResult, IcpError> {
+    let (reference_points, _) = valid_points(reference);
+    let (current_points, current_rays) = valid_points(current);
+    let floor = 1e-5 * reference.max_valid_range.max(current.max_valid_range);
+    let lines = NeighbourhoodLines::new(&reference_points, floor);
+    let current_noise = NeighbourhoodLines::new(&current_points, floor).noise_sigma;
+    let noise = match (lines.noise_sigma, current_noise) {
+        (Some(a), Some(b)) => a.max(b),
+        (Some(a), None) | (None, Some(a)) => a,
+        (None, None) => params.typical_noise_sigma,
+    }
+    .max(floor);
+    let rms_range = (current_points
+        .iter()
+        .map(|q| q[0] * q[0] + q[1] * q[1])
+        .sum::<f64>()
+        / current_points.len().max(1) as f64)
+        .sqrt();
+    let pair = Pair {
+        rms_range,
+        grid: NearestGrid::new(&reference_points, CELL, COARSE.gate),
+        reference: reference_points,
+        lines: lines.lines,
+        current: current_points,
+        current_rays,
+        current_scan: current,
+        noise,
+    };
+    let coarse = search(
+        &pair.grid,
+        &pair.reference,
+        &pair.current,
+        &first_guess,
+        params.max_linear_correction,
+        params.max_angular_correction,
+        COARSE,
+        CANDIDATES,
+        DISTINCT,
+    );
+    let mut starts: Vec<Candidate> = coarse
+        .iter()
+        .flat_map(|c| {
+            search(
+                &pair.grid,
+                &pair.reference,
+                &pair.current,
+                &c.pose,
+                COARSE.step_xy,
+                COARSE.step_theta,
+                FINE,
+                1,
+                DISTINCT,
+            )
+        })
+        .collect();
+    starts.sort_by(|a, b| b.score.total_cmp(&a.score));
+    let mut first_error = None;
+    let mut found: Vec<Refined> = Vec::new();
+    for start in &starts {
+        match pair.refine(start.pose, &first_guess, params) {
+            Ok(r) => found.push(r),
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    found.sort_by(|a, b| a.cost.total_cmp(&b.cost));
+    let Some(best) = found.first() else {
+        return Err(first_error.unwrap_or(IcpError::TooFewCorrespondences {
+            found: 0,
+            needed: params.min_correspondences,
+            iteration: 0,
+        }));
+    };
+    for other in &found[1..] {
+        let apart = best.result.pose.between(&other.result.pose);
+        let apart_theta = wrap_angle(apart.theta).abs();
+        if (apart.translation_norm() > AMBIGUOUS_APART.0 || apart_theta > AMBIGUOUS_APART.1)
+            && other.cost < best.cost + AMBIGUITY_MARGIN
+        {
+            return Err(IcpError::Ambiguous {
+                apart_m: apart.translation_norm(),
+                apart_deg: apart_theta.to_degrees(),
+            });
+        }
+    }
+    Ok(IcpResult {
+        starts: starts.len() as u32,
+        ..best.result.clone()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A segment of the test worlds.
+    type Wall = ([f64; 2], [f64; 2]);
+
+    /// Range along the ray from `origin` at `angle` to the nearest wall (0: none
+    /// within 5 m).
+    fn cast(walls: &[Wall], origin: [f64; 2], angle: f64) -> f32 {
+        let d = [angle.cos(), angle.sin()];
+        let mut best = f64::INFINITY;
+        for (a, b) in walls {
+            let e = [b[0] - a[0], b[1] - a[1]];
+            let denom = d[0] * e[1] - d[1] * e[0];
+            if denom.abs() < 1e-12 {
+                continue;
+            }
+            let w = [a[0] - origin[0], a[1] - origin[1]];
+            let t = (w[0] * e[1] - w[1] * e[0]) / denom;
+            let u = (w[0] * d[1] - w[1] * d[0]) / denom;
+            if t > 0.0 && (0.0..=1.0).contains(&u) {
+                best = best.min(t);
+            }
+        }
+        if best < 5.0 {
+            best as f32
+        } else {
+            0.0
+        }
+    }
+
+    /// A 1° scan of `walls` from `pose`, keeping one run of 5 rays in `keep_every`
+    /// (sparse: returns come in runs on an LDS).
+    fn scan(walls: &[Wall], pose: &Pose2, keep_every: usize, phase: usize) -> Vec<f32> {
+        (0..360)
+            .map(|i| {
+                if ((i / 5) * 7 + phase) % keep_every != 0 {
+                    return 0.0;
+                }
+                cast(
+                    walls,
+                    [pose.x, pose.y],
+                    pose.theta + (i as f64).to_radians(),
+                )
+            })
+            .collect()
+    }
+
+    fn angles() -> Vec<f64> {
+        (0..360).map(|i| (i as f64).to_radians()).collect()
+    }
+
+    /// A 5 m × 4 m room with a box and a pillar.
+    fn room() -> Vec<Wall> {
+        let mut walls = vec![
+            ([-2.5, -2.0], [2.5, -2.0]),
+            ([2.5, -2.0], [2.5, 2.0]),
+            ([2.5, 2.0], [-2.5, 2.0]),
+            ([-2.5, 2.0], [-2.5, -2.0]),
+        ];
+        let square = |c: [f64; 2], h: f64| {
+            [
+                ([c[0] - h, c[1] - h], [c[0] + h, c[1] - h]),
+                ([c[0] + h, c[1] - h], [c[0] + h, c[1] + h]),
+                ([c[0] + h, c[1] + h], [c[0] - h, c[1] + h]),
+                ([c[0] - h, c[1] + h], [c[0] - h, c[1] - h]),
+            ]
+        };
+        walls.extend(square([1.2, 0.8], 0.3));
+        walls.extend(square([-1.0, -1.1], 0.15));
+        walls
+    }
+
+    fn prepare(ranges: &[f32], params: &IcpParams) -> PreparedScan {
+        PreparedScan::new(ranges, &angles(), 0.06, 5.0, params).unwrap()
+    }
+
+    #[test]
+    fn recovers_the_displacement_of_noise_free_sparse_scans_exactly() {
+        let params = IcpParams::default();
+        let walls = room();
+        let (a, b) = (Pose2::new(0.1, -0.2, 0.3), Pose2::new(0.22, -0.15, 0.38));
+        // A third of the rays return, not the same ones in the two scans.
+        let reference = prepare(&scan(&walls, &a, 3, 0), &params);
+        let current = prepare(&scan(&walls, &b, 3, 1), &params);
+        assert!(reference.valid_count() <= 125 && applies(&reference, &current, &params));
+        let truth = a.between(&b);
+        let guess = Pose2::new(truth.x - 0.04, truth.y + 0.03, truth.theta - 0.05);
+        let r = match_sparse(&reference, &current, guess, &params).unwrap();
+        let e = truth.between(&r.pose);
+        assert!(e.translation_norm() < 1e-5 && e.theta.abs() < 1e-5, "{e}");
+        assert!(!r.ill_conditioned, "{r:?}");
+        // Through the matcher: the same path.
+        let via = crate::Matcher::new(params)
+            .match_scans(&reference, &current, guess)
+            .unwrap();
+        assert_eq!(via.pose, r.pose);
+    }
+
+    #[test]
+    fn refuses_a_corridor_without_ends() {
+        let params = IcpParams::default();
+        let walls = vec![([-60.0, -1.0], [60.0, -1.0]), ([-60.0, 1.2], [60.0, 1.2])];
+        let (a, b) = (Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.1, 0.02, 0.03));
+        let reference = prepare(&scan(&walls, &a, 3, 0), &params);
+        let current = prepare(&scan(&walls, &b, 3, 1), &params);
+        let r = match_sparse(&reference, &current, Pose2::IDENTITY, &params);
+        assert!(
+            !matches!(&r, Ok(r) if !r.ill_conditioned),
+            "a displacement along a corridor called determined: {r:?}"
+        );
+    }
+
+    #[test]
+    fn refuses_repeated_structure() {
+        // Posts every 0.4 m along a wall, no ends in sight: shifted by one period the
+        // scans agree as well as at the truth.
+        let mut walls = vec![([-60.0, -1.0], [60.0, -1.0])];
+        for k in -30..=30 {
+            let x = 0.4 * k as f64;
+            walls.push(([x - 0.05, 0.8], [x + 0.05, 0.8]));
+            walls.push(([x + 0.05, 0.8], [x + 0.05, 0.9]));
+            walls.push(([x - 0.05, 0.8], [x - 0.05, 0.9]));
+        }
+        let params = IcpParams::default();
+        let (a, b) = (Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.2, 0.0, 0.0));
+        let reference = prepare(&scan(&walls, &a, 2, 0), &params);
+        let current = prepare(&scan(&walls, &b, 2, 1), &params);
+        // The guess halfway between the truth and the truth shifted by one period.
+        let r = match_sparse(&reference, &current, Pose2::new(0.0, 0.0, 0.0), &params);
+        assert!(
+            !matches!(&r, Ok(r) if !r.ill_conditioned),
+            "a repeated structure called determined: {r:?}"
+        );
+    }
+
+    #[test]
+    fn dense_scans_take_the_primary_path() {
+        let params = IcpParams::default();
+        let walls = room();
+        let reference = prepare(&scan(&walls, &Pose2::IDENTITY, 1, 0), &params);
+        assert!(!applies(&reference, &reference, &params));
+        let off = IcpParams {
+            sparse_below_returns: 0,
+            ..params.clone()
+        };
+        let guess = Pose2::new(0.01, 0.0, 0.01);
+        let with = crate::Matcher::new(params).match_scans(&reference, &reference, guess);
+        let without = crate::Matcher::new(off).match_scans(&reference, &reference, guess);
+        assert_eq!(with, without);
+    }
+}
