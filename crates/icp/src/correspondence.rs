@@ -123,9 +123,7 @@ pub(crate) fn nearest_by_tree(
 
 /// The reference segment `p` lies on, given its closest reference point `j`.
 ///
-/// Returns the segment index `i` (segment from point `i` to `i + 1`), or, when `j` is
-/// an isolated point of a sparse scan with a line across the gaps,
-/// `reference.len() + j` (see [`PreparedScan::line`]).
+/// Returns the segment index `i` (segment from point `i` to `i + 1`).
 pub(crate) fn segment_for(reference: &PreparedScan, p: [f64; 2], j: usize) -> Option<usize> {
     let point = reference.rays[j].point;
     let sides = &reference.sides[j];
@@ -142,10 +140,6 @@ pub(crate) fn segment_for(reference: &PreparedScan, p: [f64; 2], j: usize) -> Op
         within_extension(reference, j, j - 1, -backward).then(|| j - 1)
     } else if backward.is_nan() && forward < 0.0 && no_return_before(reference, j) {
         within_extension(reference, j, j + 1, -forward).then_some(j)
-    } else if forward.is_nan() && backward.is_nan() {
-        // An isolated point: its line across the gaps, if it has one.
-        let isolated = reference.isolated_lines.get(j)?;
-        isolated.is_some().then_some(reference.len() + j)
     } else {
         None
     }

@@ -13,10 +13,7 @@
 //!    discontinuity, none beyond the end of a run, except up to three segment lengths
 //!    past a run that ends at readings without a return), measured against that segment's
 //!    local line, weighted by the inverse variance range noise gives the distance at
-//!    the two incidence angles. A pair of sparse scans (module `sparse`: many
-//!    readings without a return) whose own lines explain too small a share of the
-//!    current scan is matched again with short runs and isolated points on the line
-//!    through their nearest returns across the gaps.
+//!    the two incidence angles.
 //! 3. `trimming`: adaptive outlier threshold (robust σ from the median, the size of
 //!    the previous step while far from convergence, optional fraction, never
 //!    increasing).
@@ -95,7 +92,6 @@ mod preprocess;
 mod range_noise;
 mod rotation_search;
 mod solve_step;
-mod sparse;
 mod sparse_fallback;
 mod trimming;
 

@@ -6,7 +6,6 @@ use crate::covariance::{conditioning, InformationSum, RayResiduals};
 use crate::range_noise::RangeBins;
 use crate::rotation_search::candidate_rotations;
 use crate::solve_step::NormalEquations;
-use crate::sparse::worth_bridging;
 use crate::trimming::threshold;
 use crate::{IcpError, IcpParams, NeighbourSearch, PreparedScan};
 use odocal_geom::{wrap_angle, Pose2};
@@ -163,35 +162,7 @@ impl Matcher {
     /// directions agree best); the consistent result is returned, an
     /// [`IcpError::Ambiguous`] when two distinct consistent results are found, and the
     /// first attempt's error when none is.
-    ///
-    /// When either scan is sparse and its own lines explain too small a share of the
-    /// current scan ([`IcpError::SmallOverlap`]), the pair is matched again with lines
-    /// across the scans' short gaps without a return, and that error is returned if
-    /// this fails too; a pair its own lines match keeps that result.
     pub fn match_scans(
-        &mut self,
-        reference: &PreparedScan,
-        current: &PreparedScan,
-        first_guess: Pose2,
-    ) -> Result<IcpResult, IcpError> {
-        let own = self.match_prepared(reference, current, first_guess);
-        match own {
-            // Pairs the sparse fallback matched do not use the scans' lines: the
-            // bridged forms would give it the same points again.
-            Err(e)
-                if worth_bridging(&e)
-                    && (reference.has_bridged() || current.has_bridged())
-                    && !crate::sparse_fallback::applies(reference, current, &self.params) =>
-            {
-                self.match_prepared(reference.bridged(), current.bridged(), first_guess)
-                    .map_err(|_| e)
-            }
-            own => own,
-        }
-    }
-
-    /// [`Matcher::match_scans`] with the scans' lines as prepared.
-    pub(crate) fn match_prepared(
         &mut self,
         reference: &PreparedScan,
         current: &PreparedScan,
@@ -676,7 +647,7 @@ impl Matcher {
             let Some(seg) = segment_for(reference, p, j) else {
                 continue;
             };
-            let Some(line) = reference.line(seg) else {
+            let Some(line) = reference.segments[seg] else {
                 continue;
             };
             let residual = line.normal[0] * p[0] + line.normal[1] * p[1] - line.offset;

@@ -9,9 +9,6 @@
 //! rather than to the raw segment, whose direction two noisy points barely fix.
 //! On noise-free straight walls the local line is the wall itself.
 
-use crate::sparse::{
-    is_sparse, isolated_lines, missing_readings, missing_share_is_sparse, widen_short_runs,
-};
 use crate::{IcpError, IcpParams, NeighbourSearch};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 
@@ -74,14 +71,8 @@ pub struct PreparedScan {
     /// Readings without a return (zero, non-finite or below the minimum range: dark,
     /// glancing or transparent surfaces), as opposed to valid ones and to readings
     /// beyond the maximum range (a far surface was seen); all false in a scan where
-    /// they are rare (fewer than 45 %; in the [`PreparedScan::bridged`] form of a
-    /// sparse scan, all of them: see [`crate::sparse`]).
+    /// they are rare (see `no_returns`).
     pub(crate) no_return: Vec<bool>,
-    /// `isolated_lines[i]`: in the [`PreparedScan::bridged`] form of a sparse scan, the
-    /// line through isolated valid point `i` (on no usable segment) and its nearest
-    /// returns across short gaps without a return ([`crate::sparse::isolated_lines`]);
-    /// empty elsewhere.
-    pub(crate) isolated_lines: Vec<Option<SegmentLine>>,
     /// Indices of the valid readings, increasing.
     pub(crate) valid_indices: Vec<u32>,
     /// Valid readings on a usable local line (finite `incidence_cos`): the points a
@@ -105,14 +96,11 @@ pub struct PreparedScan {
     /// k-d tree over the valid points, built when the k-d search is asked for or the
     /// angles do not allow the angular search.
     pub(crate) tree: Option<PointTree>,
-    /// In a sparse scan ([`crate::sparse`]), the same scan with lines across its short
-    /// gaps without a return: used only for the pairs its own lines fail to match.
-    pub(crate) bridged: Option<Box<PreparedScan>>,
 }
 
 /// Window statistics of a local line fit.
 #[derive(Clone, Copy)]
-pub(crate) struct WindowFit {
+struct WindowFit {
     /// Centroid, relative to `origin`.
     mx: f64,
     my: f64,
@@ -121,7 +109,7 @@ pub(crate) struct WindowFit {
     sxy: f64,
     syy: f64,
     /// Smallest eigenvalue of the scatter (sum of squared line residuals).
-    pub(crate) smallest: f64,
+    smallest: f64,
     origin: [f64; 2],
 }
 
@@ -194,15 +182,44 @@ impl PreparedScan {
         let connected = connections(ranges, angles, &points, &valid, params);
         let (segments, tilt_noise_scale, noise_sigma) =
             local_lines(&points, &inv_ranges, &connected, params);
-        let missing = missing_readings(ranges, lo);
-        // The scan's own lines, the readings without a return followed past only when
-        // they are common: what every pair is matched with first.
-        let (incidence_cos, lined_count, sides) = lined_points(&points, &segments);
-        let no_return = if missing_share_is_sparse(&missing) {
-            missing.clone()
-        } else {
-            vec![false; n]
+        let incidence_cos = (0..n)
+            .map(|i| {
+                let before = i.checked_sub(1).and_then(|k| segments[k]);
+                match (before, segments[i]) {
+                    (Some(a), Some(b)) => 0.5 * (a.incidence_cos + b.incidence_cos),
+                    (Some(a), None) | (None, Some(a)) => a.incidence_cos,
+                    (None, None) => f64::NAN,
+                }
+            })
+            .collect::<Vec<f64>>();
+        let lined_count = incidence_cos.iter().filter(|c| !c.is_nan()).count();
+        // The direction between consecutive points of a usable segment is, up to its
+        // sign, the tangent of the segment's local line.
+        let unit_towards = |line: &SegmentLine, from: usize, to: usize| {
+            let t = [-line.normal[1], line.normal[0]];
+            let d = [
+                points[to][0] - points[from][0],
+                points[to][1] - points[from][1],
+            ];
+            let sign = if t[0] * d[0] + t[1] * d[1] >= 0.0 {
+                1.0
+            } else {
+                -1.0
+            };
+            [(sign * t[0]) as f32, (sign * t[1]) as f32]
         };
+        let sides = (0..n)
+            .map(|i| Sides {
+                to_next: match &segments[i] {
+                    Some(line) => unit_towards(line, i, i + 1),
+                    None => [f32::NAN; 2],
+                },
+                to_previous: match i.checked_sub(1).and_then(|k| segments[k].as_ref()) {
+                    Some(line) => unit_towards(line, i, i - 1),
+                    None => [f32::NAN; 2],
+                },
+            })
+            .collect();
         let rays = dirs
             .iter()
             .zip(&points)
@@ -214,14 +231,13 @@ impl PreparedScan {
         } else {
             None
         };
-        let mut scan = PreparedScan {
+        Ok(PreparedScan {
             angles: angles.to_vec(),
             rays,
             sides,
             points,
             valid,
-            no_return,
-            isolated_lines: Vec::new(),
+            no_return: no_returns(ranges, lo),
             incidence_cos,
             valid_indices,
             lined_count,
@@ -232,67 +248,7 @@ impl PreparedScan {
             tilt_noise_scale,
             noise_sigma,
             tree,
-            bridged: None,
-        };
-        if is_sparse(&missing) {
-            scan.bridged = Some(Box::new(
-                scan.with_bridged_lines(angles, &missing, &connected, params),
-            ));
-        }
-        Ok(scan)
-    }
-
-    /// This sparse scan with lines across its short gaps without a return (see
-    /// [`crate::sparse`]): short runs widened, isolated points lined, every reading
-    /// without a return followed past.
-    fn with_bridged_lines(
-        &self,
-        angles: &[f64],
-        missing: &[bool],
-        connected: &[bool],
-        params: &IcpParams,
-    ) -> PreparedScan {
-        let mut segments = self.segments.clone();
-        widen_short_runs(
-            &self.points,
-            angles,
-            &self.valid,
-            missing,
-            connected,
-            &mut segments,
-            params,
-        );
-        let (incidence_cos, lined_count, sides) = lined_points(&self.points, &segments);
-        let isolated_lines = isolated_lines(
-            &self.points,
-            angles,
-            &self.valid,
-            missing,
-            |i| self.valid[i] && incidence_cos[i].is_nan(),
-            params,
-        );
-        PreparedScan {
-            sides,
-            no_return: missing.to_vec(),
-            isolated_lines,
-            incidence_cos,
-            lined_count,
-            segments,
-            bridged: None,
-            ..self.clone()
-        }
-    }
-
-    /// The scan with lines across its short gaps without a return when it is sparse
-    /// (what a pair is matched with again when its scans' own lines fail), else the
-    /// scan itself.
-    pub(crate) fn bridged(&self) -> &PreparedScan {
-        self.bridged.as_deref().unwrap_or(self)
-    }
-
-    /// Whether the scan is sparse and has a [`PreparedScan::bridged`] form.
-    pub(crate) fn has_bridged(&self) -> bool {
-        self.bridged.is_some()
+        })
     }
 
     /// Range noise the scan shows about its own local lines (σ, m; `None` when it has
@@ -326,17 +282,6 @@ impl PreparedScan {
         (*self.valid.get(i)?).then(|| self.points[i])
     }
 
-    /// The line of segment code `seg` (from `correspondence::segment_for`): below
-    /// the number of readings, the local line of the segment from point `seg` to
-    /// `seg + 1`; from there on, the line of isolated point `seg − len()`.
-    #[inline]
-    pub(crate) fn line(&self, seg: usize) -> Option<SegmentLine> {
-        match seg.checked_sub(self.points.len()) {
-            None => self.segments[seg],
-            Some(j) => self.isolated_lines.get(j).copied().flatten(),
-        }
-    }
-
     /// Index of the ray whose angle is closest to `bearing` (rad, not wrapped).
     pub(crate) fn ray_near_bearing(&self, bearing: f64) -> usize {
         let n = self.angles.len();
@@ -352,54 +297,26 @@ impl PreparedScan {
     }
 }
 
-/// Per point, from the segments' lines: the incidence |cos| on its own surface (NaN
-/// when on no usable segment), the number of such lined points, and the directions to
-/// its neighbours along usable segments.
-fn lined_points(
-    points: &[[f64; 2]],
-    segments: &[Option<SegmentLine>],
-) -> (Vec<f64>, usize, Vec<Sides>) {
-    let n = points.len();
-    let incidence_cos = (0..n)
-        .map(|i| {
-            let before = i.checked_sub(1).and_then(|k| segments[k]);
-            match (before, segments[i]) {
-                (Some(a), Some(b)) => 0.5 * (a.incidence_cos + b.incidence_cos),
-                (Some(a), None) | (None, Some(a)) => a.incidence_cos,
-                (None, None) => f64::NAN,
-            }
-        })
-        .collect::<Vec<f64>>();
-    let lined_count = incidence_cos.iter().filter(|c| !c.is_nan()).count();
-    // The direction between consecutive points of a usable segment is, up to its
-    // sign, the tangent of the segment's local line.
-    let unit_towards = |line: &SegmentLine, from: usize, to: usize| {
-        let t = [-line.normal[1], line.normal[0]];
-        let d = [
-            points[to][0] - points[from][0],
-            points[to][1] - points[from][1],
-        ];
-        let sign = if t[0] * d[0] + t[1] * d[1] >= 0.0 {
-            1.0
-        } else {
-            -1.0
-        };
-        [(sign * t[0]) as f32, (sign * t[1]) as f32]
-    };
-    let sides = (0..n)
-        .map(|i| Sides {
-            to_next: match &segments[i] {
-                Some(line) => unit_towards(line, i, i + 1),
-                None => [f32::NAN; 2],
-            },
-            to_previous: match i.checked_sub(1).and_then(|k| segments[k].as_ref()) {
-                Some(line) => unit_towards(line, i, i - 1),
-                None => [f32::NAN; 2],
-            },
-        })
+/// `no_return[i]`: reading `i` is zero, non-finite or at most `lo` (m) — in a scan
+/// where such readings are common (at least [`SPARSE_SCAN_SHARE`] of them: dark or
+/// glancing surfaces, a real URG-04LX on the MinesRover logs has 55 %); elsewhere
+/// none is marked and the matches stay exactly what they were (rare dropouts cost a
+/// point or two; simulated scans with 15–20 % of their rays beyond the range, also
+/// reported as 0, moved a TurtleBot-class verdict from "weak" to "not excited").
+fn no_returns(ranges: &[f32], lo: f64) -> Vec<bool> {
+    let missing: Vec<bool> = ranges
+        .iter()
+        .map(|&r| !r.is_finite() || f64::from(r) <= lo)
         .collect();
-    (incidence_cos, lined_count, sides)
+    let count = missing.iter().filter(|&&m| m).count();
+    if (count as f64) < SPARSE_SCAN_SHARE * ranges.len() as f64 {
+        return vec![false; ranges.len()];
+    }
+    missing
 }
+
+/// See [`no_returns`].
+const SPARSE_SCAN_SHARE: f64 = 0.45;
 
 /// Unit directions of the rays. For uniformly spaced angles (every laser) they are
 /// generated by rotating with the step, re-anchored on an exact `sin_cos` every 32
@@ -644,7 +561,7 @@ fn tilt_scale(ratios: &mut [f64]) -> f64 {
 
 /// Sums of a window's coordinates about an origin, and their products.
 #[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Moments {
+struct Moments {
     x: f64,
     y: f64,
     xx: f64,
@@ -655,7 +572,7 @@ pub(crate) struct Moments {
 impl Moments {
     /// Adds (`sign` = 1) or removes (`sign` = −1) point `p`.
     #[inline]
-    pub(crate) fn add(&mut self, p: [f64; 2], origin: [f64; 2], sign: f64) {
+    fn add(&mut self, p: [f64; 2], origin: [f64; 2], sign: f64) {
         let (dx, dy) = (p[0] - origin[0], p[1] - origin[1]);
         self.x += sign * dx;
         self.y += sign * dy;
@@ -666,7 +583,7 @@ impl Moments {
 
     /// Centroid, scatter and residual sum of squares of the `count` points summed
     /// (the line itself is computed only for the windows that get used).
-    pub(crate) fn fit(&self, origin: [f64; 2], count: usize) -> WindowFit {
+    fn fit(&self, origin: [f64; 2], count: usize) -> WindowFit {
         let k = count as f64;
         let (mx, my) = (self.x / k, self.y / k);
         let sxx = (self.xx - mx * self.x).max(0.0);
@@ -702,7 +619,7 @@ impl WindowFit {
     /// The line through the centroid along the major axis of the scatter, its normal
     /// pointing towards the sensor. The normal is the eigenvector of the smallest
     /// eigenvalue, from whichever of two equivalent forms is better conditioned.
-    pub(crate) fn line(&self) -> SegmentLine {
+    fn line(&self) -> SegmentLine {
         let (sxx, sxy, syy, smallest) = (self.sxx, self.sxy, self.syy, self.smallest);
         let u = [sxy, smallest - sxx];
         let v = [smallest - syy, sxy];
