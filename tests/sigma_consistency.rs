@@ -182,18 +182,21 @@ fn realistic_presets_sigma() {
     // on every seed: the simulated URG-04LX's range error 3 mm + 4 mm/m²·r², whose
     // slope at the rover's ranges exceeds the data sheet's 1 % range-scale σ), ℓx
     // 1.42 (the slide), ℓθ 2.19 (seed 111 at −6.55σ; 1.15 without it); neato-lds
-    // ℓx 0.60, ℓθ 0.49 on the 7 seeds it calibrates (5 refused: every match fails);
-    // turtlebot4-rplidar ℓx 0.68.
+    // ℓx 0.60, ℓθ 0.49 on the 7 seeds it calibrated with the point-to-line matcher
+    // (5 refused: every match fails); with the sparse fallback (stop 27) 4 seeds
+    // calibrate (8 refused: fewer than 20 samples) and their RMS error/σ is 0.66–1.35;
+    // turtlebot4-rplidar ℓx 0.68. Not run by .ci/run (it skips this test by name):
+    // it is the target, printed by
+    // `cargo test --release --test sigma_consistency -- --ignored --nocapture realistic_presets_sigma`.
     let mut failures = Vec::new();
     for preset in ["mines-rover", "neato-lds", "turtlebot4-rplidar"] {
         let runs = realistic_errors_in_sigma(preset, 101..113);
         let labelled: Vec<([f64; 6], bool)> = runs.iter().map(|z| (*z, true)).collect();
         let r = rms(preset, &labelled);
-        assert!(
-            runs.len() >= 5,
-            "{preset}: only {} seeds calibrated",
-            runs.len()
-        );
+        if runs.len() < 5 {
+            failures.push(format!("{preset}: only {} seeds calibrated", runs.len()));
+            continue;
+        }
         for i in 0..6 {
             if !(0.7..1.3).contains(&r[i]) {
                 failures.push(format!("{preset} {}: {:.2}", NAMES[i], r[i]));
