@@ -523,26 +523,7 @@ impl Matcher {
                 break;
             }
         }
-        let correction = anchor.between(&estimate);
-        let (linear, angular) = (
-            correction.translation_norm(),
-            wrap_angle(correction.theta).abs(),
-        );
-        if linear > params.max_linear_correction || angular > params.max_angular_correction {
-            return Err(IcpError::CorrectionTooLarge {
-                linear,
-                angular,
-                max_linear: params.max_linear_correction,
-                max_angular: params.max_angular_correction,
-            });
-        }
-        if !converged {
-            return Err(IcpError::FailedToConverge {
-                iterations,
-                last_step_xy: last_step.0,
-                last_step_theta: last_step.1,
-            });
-        }
+        check_ending(&anchor, &estimate, converged, iterations, last_step, params)?;
 
         // Uncertainty at the final estimate, over the correspondences used last; the
         // residual spread over all of them (used or not) for the consistency test.
@@ -687,4 +668,38 @@ impl Matcher {
             });
         }
     }
+}
+
+/// The verdict on how an iteration ended: the correction from `anchor` (the first
+/// guess) beyond the limits, or no convergence, is an error (the order in which
+/// they are reported). Shared by the point-to-line matcher and the sparse fallback.
+pub(crate) fn check_ending(
+    anchor: &Pose2,
+    estimate: &Pose2,
+    converged: bool,
+    iterations: u32,
+    last_step: (f64, f64),
+    params: &IcpParams,
+) -> Result<(), IcpError> {
+    let correction = anchor.between(estimate);
+    let (linear, angular) = (
+        correction.translation_norm(),
+        wrap_angle(correction.theta).abs(),
+    );
+    if linear > params.max_linear_correction || angular > params.max_angular_correction {
+        return Err(IcpError::CorrectionTooLarge {
+            linear,
+            angular,
+            max_linear: params.max_linear_correction,
+            max_angular: params.max_angular_correction,
+        });
+    }
+    if !converged {
+        return Err(IcpError::FailedToConverge {
+            iterations,
+            last_step_xy: last_step.0,
+            last_step_theta: last_step.1,
+        });
+    }
+    Ok(())
 }

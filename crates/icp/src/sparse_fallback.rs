@@ -23,6 +23,7 @@
 use crate::consistency::{check_consistency, robust_spread};
 use crate::correlative::{search, Candidate, Level};
 use crate::covariance::{InformationSum, RayResiduals};
+use crate::matcher::check_ending;
 use crate::nearest_grid::NearestGrid;
 use crate::neighbourhood_lines::{NeighbourhoodLine, NeighbourhoodLines};
 use crate::range_noise::RangeBins;
@@ -253,26 +254,7 @@ impl Pair<'_> {
             }
             history[iterations as usize % history.len()] = fingerprint;
         }
-        let correction = anchor.between(&pose);
-        let (linear, angular) = (
-            correction.translation_norm(),
-            wrap_angle(correction.theta).abs(),
-        );
-        if linear > params.max_linear_correction || angular > params.max_angular_correction {
-            return Err(IcpError::CorrectionTooLarge {
-                linear,
-                angular,
-                max_linear: params.max_linear_correction,
-                max_angular: params.max_angular_correction,
-            });
-        }
-        if !converged {
-            return Err(IcpError::FailedToConverge {
-                iterations,
-                last_step_xy: last_step.0,
-                last_step_theta: last_step.1,
-            });
-        }
+        check_ending(anchor, &pose, converged, iterations, last_step, params)?;
         self.result(pose, gate(iterations), iterations, params)
     }
 
