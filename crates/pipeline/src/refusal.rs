@@ -9,6 +9,11 @@ use odocal_solver::{Calibration, Constraint, Params, Sample, SolveOptions, Verdi
 /// Most scan pairs failed to match when failures exceed this share of the pairs tried.
 pub const FAILED_MATCH_SHARE: f64 = 0.5;
 
+/// A set of parameters is proposed for holding only if the others stay well
+/// determined with their σ this much larger: the run with them held matches the scans
+/// anew (guesses and sweep compensation from the held values), which moves σ a little.
+pub const HOLD_SIGMA_MARGIN: f64 = 1.1;
+
 /// The order in which parameters are proposed for holding: the laser's offset across
 /// the robot first (most robots mount it on the centre line), then its offset along it,
 /// its heading, then the wheels (harder to know: a skid-steered robot's effective
@@ -114,7 +119,7 @@ fn all_determined(c: &Calibration) -> bool {
         .all(|p| p.verdict == Verdict::WellDetermined)
 }
 
-/// The fewest parameters (one, else two) that, held, leave every other parameter well
+/// The fewest parameters (one, two, else three) that, held, leave every other parameter well
 /// determined, preferring ℓy, ℓx, ℓθ, b, then the radii; empty when none does. Which ones is found
 /// by holding them at the refused estimate (the σ of the rest barely depend on the
 /// held value); the values proposed come from `--nominal`, the usual mounting (ℓy and
@@ -137,13 +142,25 @@ pub fn holds(
             sets.push(vec![i, j]);
         }
     }
+    for (a, &i) in free.iter().enumerate() {
+        for (b, &j) in free.iter().enumerate().skip(a + 1) {
+            for &k in &free[b + 1..] {
+                sets.push(vec![i, j, k]);
+            }
+        }
+    }
     let works = |set: &[usize]| {
         let mut o = *options;
         o.accept_weak = true;
         for &i in set {
             o.constraints.0[i] = Constraint::Held(estimate[i]);
         }
-        odocal_solver::calibrate(samples, &o).is_ok_and(|c| all_determined(&c))
+        odocal_solver::calibrate(samples, &o).is_ok_and(|mut c| {
+            // With a margin: the command proposed is run on data matched anew with
+            // the held values, and must not land just past a threshold.
+            odocal_solver::inflate_sigma(&mut c, HOLD_SIGMA_MARGIN);
+            all_determined(&c)
+        })
     };
     let Some(set) = sets.into_iter().find(|s| works(s)) else {
         return Vec::new();

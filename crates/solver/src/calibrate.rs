@@ -8,9 +8,10 @@ use crate::kinematics::{residual_of, Predictor, RawOdometry};
 use crate::matcher_bias::bias_covariance;
 use crate::noise::{residual_sigmas, NoiseWeights};
 use crate::observability::{
-    information_not_excited, null_direction_names, parameter_reports, sentence, step1_not_excited,
+    full_sentence, information_not_excited, judged, null_direction_names, step1_not_excited,
     step2_not_excited, wheel_signs, MotionContent, Observability, Verdict,
 };
+use crate::one_sample::resting_on_one_sample;
 use crate::packed::Packed;
 use crate::params::Params;
 use crate::partial::{step1_held, step2_held};
@@ -452,7 +453,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // Motion classes with the estimated radii; for the "not excited" errors, where
     // the estimate is not trustworthy, with equal radii.
     let motion_equal_radii = || MotionContent::classify(&active, 1.0, 1.0);
-    let (covariance, shared_scan_noise) = match invert_information(&information) {
+    let (covariance, shared_scan_noise, inverse) = match invert_information(&information) {
         Inversion::Covariance(c) => {
             let inverse = zero_held_rows(*c, &constraints);
             let bias = bias_covariance(&active, &params, &weights, &inverse, options.matcher_bias);
@@ -463,6 +464,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
             (
                 std::array::from_fn(|i| std::array::from_fn(|j| random[i][j] + bias[i][j])),
                 model,
+                inverse,
             )
         }
         Inversion::Singular(null) => {
@@ -472,7 +474,10 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
             ))
         }
     };
-    let reports = parameter_reports(&params, &covariance, &constraints);
+    // A parameter that one sample determines almost alone is not well determined:
+    // nothing in the data checks that sample.
+    let mut one_sample = resting_on_one_sample(&active, &params, &weights, &inverse);
+    let reports = judged(&params, &covariance, &constraints, &mut one_sample);
     let not_excited: Vec<String> = reports
         .iter()
         .filter(|r| r.verdict == Verdict::NotExcited)
@@ -486,10 +491,11 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         step1_condition: cf.step1.condition,
         a_condition: cf.step2.a_condition,
         a_condition_scaled: cf.step2.a_condition_scaled,
-        sentence: sentence(&reports, &motion),
+        sentence: full_sentence(&reports, &motion, &one_sample),
         parameters: reports,
         motion,
         wheel_signs: wheel_signs(&params),
+        one_sample,
     };
     let mut used = vec![false; samples.len()];
     for p in &active {

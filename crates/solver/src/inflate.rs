@@ -3,8 +3,6 @@
 //! slide's too), the verdicts and the sentence follow.
 
 use crate::calibrate::Calibration;
-use crate::constraints::Constraints;
-use crate::observability::{parameter_reports, sentence};
 
 /// Multiplies every σ of `calibration` by `factor` (the covariance by `factor²`) and
 /// judges the parameters again; a `factor` that is not finite or below 1 changes
@@ -23,12 +21,7 @@ pub fn inflate_sigma(calibration: &mut Calibration, factor: f64) {
         slip.sigma *= factor;
         slip.covariance_with_params = slip.covariance_with_params.map(|c| c * f2);
     }
-    let obs = &mut calibration.observability;
-    let constraints = Constraints(std::array::from_fn(|i| {
-        obs.parameters
-            .get(i)
-            .map_or(Default::default(), |p| p.constraint)
-    }));
-    obs.parameters = parameter_reports(&calibration.params, &calibration.covariance, &constraints);
-    obs.sentence = sentence(&obs.parameters, &obs.motion);
+    calibration
+        .observability
+        .rejudge(&calibration.params, &calibration.covariance);
 }

@@ -394,6 +394,9 @@ impl LasersCalibration {
         let mut c = self.own[k].clone();
         let reports = parameter_reports(&params, &covariance, &self.constraints[k]);
         c.observability.sentence = sentence(&reports, &c.observability.motion);
+        // The laser's own solve's one-sample findings are not those of the joint
+        // information: not carried over (and not judged again on the joint solve).
+        c.observability.one_sample = Vec::new();
         c.observability.parameters = reports;
         c.observability.wheel_signs = wheel_signs(&params);
         c.j = params.j();

@@ -15,7 +15,7 @@ use crate::kinematics::residual_of;
 use crate::linalg::unit_diagonal;
 use crate::noise::NoiseWeights;
 use crate::normal_equations::NormalEquations;
-use crate::observability::{parameter_reports, sentence, wheel_signs};
+use crate::observability::wheel_signs;
 use crate::params::Params;
 use crate::sample::Sample;
 use crate::slide_kinematics::predict_with_slide;
@@ -89,13 +89,7 @@ impl SlideFit {
     /// joint ones and records the slide as applied.
     pub fn apply(self, calibration: &mut Calibration) {
         let obs = &mut calibration.observability;
-        let constraints = Constraints(std::array::from_fn(|i| {
-            obs.parameters
-                .get(i)
-                .map_or(Default::default(), |p| p.constraint)
-        }));
-        obs.parameters = parameter_reports(&self.params, &self.covariance, &constraints);
-        obs.sentence = sentence(&obs.parameters, &obs.motion);
+        obs.rejudge(&self.params, &self.covariance);
         obs.wheel_signs = wheel_signs(&self.params);
         calibration.params = self.params;
         calibration.j = self.params.j();

@@ -61,6 +61,7 @@ mod matcher_bias;
 mod noise;
 mod normal_equations;
 mod observability;
+mod one_sample;
 mod packed;
 mod params;
 mod partial;
@@ -93,6 +94,7 @@ pub use observability::{
     MotionContent, Observability, ParameterReport, Verdict, MOTION_CLASS_RATIO,
     PARTIAL_CALIBRATION_HINT,
 };
+pub use one_sample::{describe as describe_one_sample, OneSampleSupport, ONE_SAMPLE_SIGMA_RATIO};
 pub use params::{Params, PARAMETER_NAMES};
 pub use range_scale::{range_scale_covariance, range_scale_direction, with_range_scale};
 pub use refine::Refinement;

@@ -148,6 +148,69 @@ pub struct Observability {
     pub sentence: String,
     /// Set when a radius came out negative: reversed encoder signs or swapped wheels.
     pub wheel_signs: Option<String>,
+    /// Parameters that one sample determines almost alone (see
+    /// [`crate::OneSampleSupport`]): none of them is "well determined".
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub one_sample: Vec<crate::OneSampleSupport>,
+}
+
+impl Observability {
+    /// Judges the parameters again after their estimate or covariance changed (σ
+    /// inflated, a slide term added): verdicts from the new σ, the same constraints,
+    /// the parameters resting on one sample still not "well determined", and the
+    /// sentence anew.
+    pub(crate) fn rejudge(&mut self, params: &Params, covariance: &[[f64; 6]; 6]) {
+        let constraints = Constraints(std::array::from_fn(|i| {
+            self.parameters
+                .get(i)
+                .map_or(Default::default(), |p| p.constraint)
+        }));
+        self.parameters = judged(params, covariance, &constraints, &mut self.one_sample);
+        self.sentence = full_sentence(&self.parameters, &self.motion, &self.one_sample);
+    }
+}
+
+/// [`parameter_reports`], with a parameter judged weak where one sample decides its
+/// verdict: "well determined" with the sample, not without it (σ times its
+/// [`crate::OneSampleSupport::sigma_ratio`]); marks those supports as deciding.
+pub(crate) fn judged(
+    params: &Params,
+    covariance: &[[f64; 6]; 6],
+    constraints: &Constraints,
+    one_sample: &mut [crate::OneSampleSupport],
+) -> Vec<ParameterReport> {
+    let mut reports = parameter_reports(params, covariance, constraints);
+    for s in one_sample.iter_mut() {
+        s.decides_verdict = false;
+        for (i, r) in reports.iter_mut().enumerate() {
+            if r.name != s.parameter || r.verdict != Verdict::WellDetermined {
+                continue;
+            }
+            let without = s.sigma_ratio.map_or(f64::INFINITY, |k| k * r.sigma);
+            if verdict(i, r.value, without, params.b) != Verdict::WellDetermined {
+                r.verdict = Verdict::Weak;
+                s.decides_verdict = true;
+            }
+        }
+    }
+    reports
+}
+
+/// [`sentence`], followed by what rests on one sample.
+pub(crate) fn full_sentence(
+    reports: &[ParameterReport],
+    motion: &MotionContent,
+    one_sample: &[crate::OneSampleSupport],
+) -> String {
+    if !one_sample.iter().any(|s| s.decides_verdict) {
+        sentence(reports, motion)
+    } else {
+        format!(
+            "{}; {}",
+            sentence(reports, motion),
+            crate::one_sample::describe(one_sample)
+        )
+    }
 }
 
 /// Verdict for parameter `index` with value `value`, σ `sigma` and wheel distance `b`.
