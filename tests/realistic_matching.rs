@@ -51,6 +51,9 @@ struct Yield {
     nees: Vec<f64>,
     /// The matcher's rejections, by reason.
     rejections: BTreeMap<&'static str, usize>,
+    /// Per accepted match (same order): matched through the scans between the pair's
+    /// two (`odocal_pipeline::chained`) rather than directly.
+    chained: Vec<bool>,
 }
 
 impl Yield {
@@ -60,6 +63,7 @@ impl Yield {
         self.overlapping_matched += other.overlapping_matched;
         self.errors.extend_from_slice(&other.errors);
         self.nees.extend_from_slice(&other.nees);
+        self.chained.extend_from_slice(&other.chained);
         for (k, v) in &other.rejections {
             *self.rejections.entry(k).or_default() += v;
         }
@@ -86,6 +90,19 @@ impl Yield {
             .zip(&self.nees)
             .filter(|((d, a), n)| (*d > MAX_ERROR_M || *a > MAX_ERROR_RAD) && **n > NEES_997)
             .count()
+    }
+
+    /// Accepted matches composed through intermediate scans, and of those the ones
+    /// beyond 5 mm or 0.5° of the truth.
+    fn chained_wrong(&self) -> (usize, usize) {
+        let chained = self.chained.iter().filter(|c| **c).count();
+        let wrong = self
+            .errors
+            .iter()
+            .zip(&self.chained)
+            .filter(|((d, a), c)| **c && (*d > MAX_ERROR_M || *a > MAX_ERROR_RAD))
+            .count();
+        (chained, wrong)
     }
 
     /// Mean NEES of the accepted matches (3 when their covariances are right).
@@ -124,7 +141,7 @@ impl Yield {
             .map(|(k, n)| format!("{k} {n}"))
             .collect();
         format!(
-            "| {label} | {} | {} | {}/{} ({:.0} %) | {} | {rd:.1} mm / {ra:.2}° | {wd:.1} mm / {wa:.2}° | {} ({:.0} %) | {} | {:.1}, {:.1} % | {} |",
+            "| {label} | {} | {} | {}/{} ({:.0} %) | {} | {rd:.1} mm / {ra:.2}° | {wd:.1} mm / {wa:.2}° | {} ({:.0} %) | {} | {:.1}, {:.1} % | {} | {} ({}) |",
             self.tried,
             self.overlapping,
             self.overlapping_matched,
@@ -136,12 +153,14 @@ impl Yield {
             self.wrong_uncovered(),
             self.mean_nees(),
             100.0 * self.nees_beyond(),
-            reasons.join(", ")
+            reasons.join(", "),
+            self.chained_wrong().0,
+            self.chained_wrong().1,
         )
     }
 }
 
-const TABLE_HEADER: &str = "| preset, seeds | pairs tried | true overlap ≥ ½ | matched of those | accepted | RMS error | worst error | beyond 5 mm / 0.5° | of those, NEES > 14.2 | NEES: mean, share > 14.2 | rejections |\n|---|---|---|---|---|---|---|---|---|---|---|";
+const TABLE_HEADER: &str = "| preset, seeds | pairs tried | true overlap ≥ ½ | matched of those | accepted | RMS error | worst error | beyond 5 mm / 0.5° | of those, NEES > 14.2 | NEES: mean, share > 14.2 | rejections | matched through scans between (beyond) |\n|---|---|---|---|---|---|---|---|---|---|---|---|";
 
 /// The share of the returns of `second` (taken from `p2`) that the sensor at `p1` sees
 /// too: the ray from `p1` toward each point reaches it (nothing nearer in between,
@@ -213,13 +232,13 @@ fn measure_in(config: SimConfig, world: &World) -> Yield {
             scans[i].sensor
         }
     };
-    let matched: BTreeMap<(usize, usize), (Pose2, Covariance)> = synced
+    let matched: BTreeMap<(usize, usize), (Pose2, Covariance, bool)> = synced
         .samples
         .iter()
         .map(|s| {
             (
                 (s.pair.first, s.pair.second),
-                (s.icp.pose, s.icp.covariance),
+                (s.icp.pose, s.icp.covariance, s.icp.links > 1),
             )
         })
         .collect();
@@ -243,7 +262,8 @@ fn measure_in(config: SimConfig, world: &World) -> Yield {
                 y.overlapping_matched += 1;
             }
         }
-        if let Some((pose, cov)) = accepted {
+        if let Some((pose, cov, chained)) = accepted {
+            y.chained.push(*chained);
             let truth = a.inverse().compose(&b);
             let e = truth.inverse().compose(pose);
             y.errors

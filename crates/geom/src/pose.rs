@@ -55,6 +55,20 @@ impl Pose2 {
         )
     }
 
+    /// The Jacobians of `self ⊕ other` with respect to `self` and to `other`
+    /// (rows and columns `x, y, theta`), for first-order covariance propagation:
+    /// `Σ = J_a Σ_a J_aᵀ + J_b Σ_b J_bᵀ` for independent `self` and `other`.
+    pub fn compose_jacobians(&self, other: &Pose2) -> ([[f64; 3]; 3], [[f64; 3]; 3]) {
+        let (s, c) = self.theta.sin_cos();
+        let j_self = [
+            [1.0, 0.0, -s * other.x - c * other.y],
+            [0.0, 1.0, c * other.x - s * other.y],
+            [0.0, 0.0, 1.0],
+        ];
+        let j_other = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        (j_self, j_other)
+    }
+
     /// `⊖self`: the inverse motion, so that `self.compose(&self.inverse())` is the identity.
     pub fn inverse(&self) -> Pose2 {
         let (s, c) = self.theta.sin_cos();
@@ -115,6 +129,33 @@ mod tests {
         assert!(close(&a.inverse().compose(&a), &Pose2::IDENTITY));
         assert!(close(&a.compose(&b).compose(&b.inverse()), &a));
         assert!(close(&a.between(&a.compose(&b)), &b));
+    }
+
+    #[test]
+    fn compose_jacobians_match_finite_differences() {
+        let a = Pose2::new(0.3, -0.2, 0.7);
+        let b = Pose2::new(-0.15, 0.4, -1.1);
+        let (ja, jb) = a.compose_jacobians(&b);
+        let h = 1e-7;
+        for k in 0..3 {
+            let mut da = a.to_array();
+            da[k] += h;
+            let mut db = b.to_array();
+            db[k] += h;
+            let fa = Pose2::from_array(da).compose(&b).to_array();
+            let fb = a.compose(&Pose2::from_array(db)).to_array();
+            let f0 = a.compose(&b).to_array();
+            for r in 0..3 {
+                assert!(
+                    ((fa[r] - f0[r]) / h - ja[r][k]).abs() < 1e-6,
+                    "J_a[{r}][{k}]"
+                );
+                assert!(
+                    ((fb[r] - f0[r]) / h - jb[r][k]).abs() < 1e-6,
+                    "J_b[{r}][{k}]"
+                );
+            }
+        }
     }
 
     #[test]

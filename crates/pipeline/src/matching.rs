@@ -21,6 +21,9 @@ pub struct MatchStats {
     pub correspondences: usize,
     /// Mean point-to-line residual (m).
     pub mean_residual: f64,
+    /// Matches composed into ŝ: 1 for the pair's own match, more when the pair was
+    /// matched through the scans between its two (see [`crate::chained`]).
+    pub links: u32,
 }
 
 /// Scans sampled to estimate the log's typical range noise.
@@ -148,6 +151,7 @@ pub fn match_pairs(
                 iterations: r.iterations,
                 correspondences: r.correspondences,
                 mean_residual: r.mean_residual,
+                links: 1,
             })
         },
         done,

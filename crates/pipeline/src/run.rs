@@ -1,5 +1,6 @@
 //! The whole pipeline: synchronize, match, (estimate the clock offset,) solve.
 
+use crate::chained::{rescue_refused, LinkSource};
 use crate::consistency::{check_halves, Consistency};
 use crate::error::PipelineError;
 use crate::finding::{Finding, FindingKind};
@@ -117,6 +118,17 @@ fn first_guesses(
     }
 }
 
+/// The time each scan stands for: its reference time (the timestamp without a sweep).
+fn reference_times(log: &Log) -> Vec<f64> {
+    (0..log.scans.len())
+        .map(|i| {
+            log.scans
+                .get(i)
+                .map_or(log.scans.scans[i].t, |s| reference_time(&s))
+        })
+        .collect()
+}
+
 /// Synchronizes the encoder and scan streams and matches the pairs.
 pub fn synchronize_and_match(
     log: &Log,
@@ -127,14 +139,7 @@ pub fn synchronize_and_match(
     let ticks = ticks_per_revolution(log, opts)?;
     health::plausibility::check(log, ticks)?;
     let t_sync = Instant::now();
-    // Each scan stands for its reference time (the timestamp without a sweep).
-    let scan_times: Vec<f64> = (0..log.scans.len())
-        .map(|i| {
-            log.scans
-                .get(i)
-                .map_or(log.scans.scans[i].t, |s| reference_time(&s))
-        })
-        .collect();
+    let scan_times = reference_times(log);
     let sweep = has_sweep(&log.scans);
     let stride = match opts.stride {
         Some(0) => {
@@ -260,8 +265,26 @@ pub fn synchronize_and_match(
         rest.iter().map(|&i| (i, kept[i].1.clone())).collect();
     let guesses = first_guesses(&rest_motions, guess_params.as_ref(), opts.use_profile);
     let rest_pairs: Vec<(usize, usize)> = rest.iter().map(|&i| index_pairs[i]).collect();
-    let results = match_pairs(&scans, &rest_pairs, &guesses, &icp, || progress.advance());
+    let mut results = match_pairs(&scans, &rest_pairs, &guesses, &icp, || progress.advance());
     let sweep_compensated = matches!(scans, Cow::Owned(_));
+    // Pairs refused for what closer scans cure, matched through the scans between.
+    let links = LinkSource {
+        scans: &log.scans,
+        scan_times: &scan_times,
+        track: &track,
+        limits: &limits,
+        params: guess_params.as_ref(),
+        use_profile: opts.use_profile,
+        time_offset: opts.time_offset,
+    };
+    rescue_refused(
+        &links,
+        &mut scans,
+        sweep_compensated,
+        &rest_pairs,
+        &mut results,
+        &icp,
+    );
     for (i, r) in rest.into_iter().zip(results) {
         matched[i] = Some(r);
     }
@@ -324,8 +347,9 @@ fn second_pass(
         .iter()
         .map(|s| (s.pair.first, s.pair.second))
         .collect();
-    let (scans, covered) = if has_sweep(&log.scans) {
-        let track = EncoderTrack::new(&log.encoders, synced.ticks_per_revolution);
+    let track = EncoderTrack::new(&log.encoders, synced.ticks_per_revolution);
+    let sweep = has_sweep(&log.scans);
+    let (mut scans, covered) = if sweep {
         let (store, covered) = compensated_pairs(
             &log.scans,
             &index_pairs,
@@ -339,11 +363,21 @@ fn second_pass(
     } else {
         (Cow::Borrowed(&log.scans), vec![true; index_pairs.len()])
     };
+    let icp = with_typical_noise(&opts.icp, typical_noise_sigma(&scans, &opts.icp));
     progress.start("matching (second pass)", index_pairs.len());
-    let matched: Vec<Result<MatchStats, MatchFailure>> =
-        match_pairs(&scans, &index_pairs, &guesses, &opts.icp, || {
-            progress.advance()
-        });
+    let mut matched: Vec<Result<MatchStats, MatchFailure>> =
+        match_pairs(&scans, &index_pairs, &guesses, &icp, || progress.advance());
+    let scan_times = reference_times(log);
+    let links = LinkSource {
+        scans: &log.scans,
+        scan_times: &scan_times,
+        track: &track,
+        limits: &synced.limits,
+        params: Some(params),
+        use_profile: opts.use_profile,
+        time_offset: synced.time_offset,
+    };
+    rescue_refused(&links, &mut scans, sweep, &index_pairs, &mut matched, &icp);
     progress.finish();
     let old = std::mem::take(&mut synced.samples);
     for ((s, m), covered) in old.into_iter().zip(matched).zip(covered) {

@@ -50,7 +50,8 @@ impl PairSample {
     /// The tuple record: the original package's `T`, `phi_l`, `phi_r`, `sm`, plus the
     /// scan timestamps `t0`, `t1` (laser clock), ŝ's covariance, the encoder profile and
     /// the ICP statistics (`icp_iterations`, `icp_correspondences`,
-    /// `icp_mean_residual`, `scan0`, `scan1`).
+    /// `icp_mean_residual`, `scan0`, `scan1`; `icp_links` when ŝ was composed of several
+    /// matches).
     pub fn to_tuple(&self) -> TupleRecord {
         let w = &self.wheel;
         let mut rec = TupleRecord::new(
@@ -77,6 +78,10 @@ impl PairSample {
             self.icp.correspondences.into(),
         );
         extra.insert("icp_mean_residual".into(), self.icp.mean_residual.into());
+        if self.icp.links > 1 {
+            // Matched through the scans between the pair's two (crate::chained).
+            extra.insert("icp_links".into(), self.icp.links.into());
+        }
         rec
     }
 }
@@ -174,6 +179,7 @@ mod tests {
                 iterations: k as u32 % 17,
                 correspondences: 600 + k % 50,
                 mean_residual: 1e-3 / (1.0 + x),
+                links: 1,
             },
         }
     }

@@ -145,23 +145,7 @@ pub fn compensated_pairs(
         if let Some(Some(done)) = covered.get(i) {
             return *done;
         }
-        let result = scans.get(i).and_then(|s| {
-            let (ranges, angles) = compensate_scan(&s, track, limits, params, time_offset)?;
-            Some((s, ranges, angles))
-        });
-        let done = result.is_some();
-        if let Some((s, ranges, angles)) = result {
-            let meta = &mut out.scans[i];
-            out.ranges[meta.offset..meta.offset + ranges.len()].copy_from_slice(&ranges);
-            let mut g = odocal_log::ScanGeometry::from_angles(
-                angles,
-                s.geometry.max_range,
-                s.geometry.min_range,
-            );
-            g.laser_type = s.geometry.laser_type;
-            meta.geometry = out.geometries.len() as u32;
-            out.geometries.push(g);
-        }
+        let done = compensate_into(out, scans, i, track, limits, params, time_offset);
         if let Some(c) = covered.get_mut(i) {
             *c = Some(done);
         }
@@ -175,6 +159,36 @@ pub fn compensated_pairs(
         })
         .collect();
     (out, ok)
+}
+
+/// Compensates scan `i` of `source` into `out`, a copy of `source` (same scans, same
+/// layout): its ranges replaced and its own angle table added. False, and `out` left
+/// as it is, when the encoders do not cover the sweep or there is no scan `i`. What
+/// [`compensated_pairs`] does for each scan of its pairs, for scans needed later (the
+/// intermediate scans of a chain, [`crate::chained`]).
+pub fn compensate_into(
+    out: &mut ScanStore,
+    source: &ScanStore,
+    i: usize,
+    track: &EncoderTrack<'_>,
+    limits: &SyncLimits,
+    params: &Params,
+    time_offset: f64,
+) -> bool {
+    let Some(s) = source.get(i) else {
+        return false;
+    };
+    let Some((ranges, angles)) = compensate_scan(&s, track, limits, params, time_offset) else {
+        return false;
+    };
+    let meta = &mut out.scans[i];
+    out.ranges[meta.offset..meta.offset + ranges.len()].copy_from_slice(&ranges);
+    let mut g =
+        odocal_log::ScanGeometry::from_angles(angles, s.geometry.max_range, s.geometry.min_range);
+    g.laser_type = s.geometry.laser_type;
+    meta.geometry = out.geometries.len() as u32;
+    out.geometries.push(g);
+    true
 }
 
 #[cfg(test)]

@@ -51,6 +51,10 @@ pub struct Report {
     /// The pairs discarded as `match_failed`, by the matcher's reason (overlap,
     /// residuals, correction, correspondences, conditioning, ambiguity, …).
     pub match_rejections: RejectionCounts,
+    /// Pairs refused when matched directly and matched through the scans between
+    /// their two instead (a chain of 2 to 4 shorter matches; see
+    /// `odocal_pipeline::chained`), among the samples synchronized.
+    pub chained_matches: usize,
     /// The scan matcher's own error per pair, measured on this log by the closure of
     /// scan triples; absent when too few triples close.
     pub match_self_check: Option<MatchSelfCheck>,
@@ -229,6 +233,12 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         scan_pairs: outcome.synced.pairs,
         discarded: outcome.synced.discarded.clone(),
         match_rejections: outcome.synced.match_rejections.clone(),
+        chained_matches: outcome
+            .synced
+            .samples
+            .iter()
+            .filter(|s| s.icp.links > 1)
+            .count(),
         match_self_check: outcome.synced.match_self_check,
         stride: e.stride,
         interval_s: e.interval_s,
@@ -402,6 +412,13 @@ impl fmt::Display for Report {
                 "    most often {} ({n}): {}",
                 reason.key(),
                 reason.advice()
+            )?;
+        }
+        if self.chained_matches > 0 {
+            writeln!(
+                f,
+                "  matched through the scans between: {} pairs refused when matched directly (ŝ composed of 2 to 4 shorter matches)",
+                self.chained_matches
             )?;
         }
         if let Some(c) = &self.match_self_check {

@@ -307,6 +307,7 @@ mod tests {
                         iterations: 1,
                         correspondences: 100,
                         mean_residual: 0.0,
+                        links: 1,
                     },
                 }
             })
