@@ -1,7 +1,8 @@
 //! The scan matcher's own error on a log without ground truth: closure of scan
 //! triples.
 //!
-//! For consecutive samples `(a, b)` and `(b, c)` the matcher also matches `(a, c)`
+//! For consecutive samples `(a, b)` and `(b, c)` matched directly (not through the
+//! scans between, [`crate::chained`]) the matcher also matches `(a, c)`
 //! directly, from the guess `ŝ_ab ⊕ ŝ_bc`. The closure error `ŝ_ac ⊖ (ŝ_ab ⊕ ŝ_bc)`
 //! holds the errors of three matches; with errors of similar size and independent
 //! (they share scans, so partly correlated: the figure is a lower bound then), its
@@ -56,7 +57,11 @@ pub fn closure_check(
 ) -> Option<MatchSelfCheck> {
     let triples: Vec<(&MatchStats, &MatchStats, (usize, usize))> = samples
         .windows(2)
-        .filter(|w| w[0].pair.second == w[1].pair.first)
+        // Direct matches only: a pair matched through the scans between its two was
+        // refused directly, and so, mostly, is the pair twice as long over it.
+        .filter(|w| {
+            w[0].pair.second == w[1].pair.first && w[0].icp.links == 1 && w[1].icp.links == 1
+        })
         .map(|w| (&w[0].icp, &w[1].icp, (w[0].pair.first, w[1].pair.second)))
         .collect();
     let every = (triples.len() / MAX_TRIPLES).max(1);
