@@ -6,9 +6,10 @@
 //! residuals' dependence on the slide's predicted displacement (the same turn driven
 //! faster slides more), the six parameters re-fitted with it. It fires when `k` is
 //! outward (`k > 0`, what a skid-steer robot's wheels do), significant (above
-//! [`SIGNIFICANCE`] σ) and matters (it moves ℓx by more than ℓx's own σ); then the
+//! [`SIGNIFICANCE`] σ) and matters (it moves some parameter — ℓx in most logs, ℓθ
+//! where the arcs are what fix the heading — by more than its own σ); then the
 //! estimate includes it and a finding says so. An outward `k` too uncertain to be
-//! sure of that would still move ℓx by more than its σ gets a note naming
+//! sure of that would still move a parameter by more than its σ gets a note naming
 //! `--lateral-slip`; an inward `k` as significant is no slide a robot does: named,
 //! not used.
 
@@ -33,10 +34,16 @@ pub enum SlideModel {
     Off,
 }
 
-/// Whether a checked slide is one to estimate: outward, significant, and moving ℓx
-/// by more than ℓx's σ without it.
-fn found(slip: &LateralSlip, sigma_l_x: f64) -> bool {
-    slip.k > 0.0 && slip.significance() > SIGNIFICANCE && slip.l_x_shift.abs() > sigma_l_x
+/// Whether a slide matters: ignoring it moves some parameter by more than its σ in
+/// `covariance` (the six-parameter estimate's); the parameter and by how many σ.
+fn matters(slip: &LateralSlip, covariance: &[[f64; 6]; 6]) -> Option<(usize, f64)> {
+    slip.largest_shift(covariance).filter(|(_, n)| *n > 1.0)
+}
+
+/// Whether a checked slide is one to estimate: outward, significant, and moving some
+/// parameter by more than its σ without it.
+fn found(slip: &LateralSlip, covariance: &[[f64; 6]; 6]) -> bool {
+    slip.k > 0.0 && slip.significance() > SIGNIFICANCE && matters(slip, covariance).is_some()
 }
 
 /// Checks `calibration` (computed from `samples` with `options`) for the slide and,
@@ -54,8 +61,7 @@ pub fn check_and_apply(
     let Some(fit) = fit_lateral_slip(samples, calibration, options) else {
         return;
     };
-    let sigma_l_x = calibration.covariance[3][3].max(0.0).sqrt();
-    if model == SlideModel::Estimate || found(&fit.slip, sigma_l_x) {
+    if model == SlideModel::Estimate || found(&fit.slip, &calibration.covariance) {
         fit.apply(calibration);
     } else {
         calibration.lateral_slip = Some(fit.slip);
@@ -106,19 +112,33 @@ pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> 
             ),
         ));
     }
-    let sigma_l_x = calibration.covariance[3][3].max(0.0).sqrt();
-    if slip.k > 0.0 && slip.l_x_shift.abs() > sigma_l_x {
+    let moved = matters(slip, &calibration.covariance);
+    if let (true, Some((i, n))) = (slip.k > 0.0, moved) {
         // Not significant, but it would matter: a skid-steer robot's user should
-        // know what the slide would do to ℓx.
+        // know what the slide would do to the parameters.
+        let off = if i == 5 {
+            format!(
+                "{:+.4} rad ({:+.2}°)",
+                -slip.shifts[i],
+                -slip.shifts[i].to_degrees()
+            )
+        } else {
+            format!("{:+.1} mm", -1e3 * slip.shifts[i])
+        };
         return Some(Finding::note(
             FindingKind::LateralSlip,
             format!(
                 "a sideways slide in turns is not excluded: {numbers}, {:.1}σ, too little \
-                 to be sure; if the robot slides (a skid-steer robot does), ℓx is {:+.1} mm \
-                 off, more than its σ: `--lateral-slip` estimates the slide with the six \
-                 parameters",
+                 to be sure; if the robot slides (a skid-steer robot does), {} is {off} \
+                 off ({n:.1} times its σ){}: `--lateral-slip` estimates the slide with the \
+                 six parameters",
                 slip.significance(),
-                -1e3 * slip.l_x_shift
+                odocal_solver::PARAMETER_NAMES[i],
+                if i == 3 {
+                    String::new()
+                } else {
+                    format!(", ℓx {:+.1} mm", -1e3 * slip.l_x_shift)
+                }
             ),
         ));
     }
@@ -145,6 +165,7 @@ mod tests {
             sigma,
             covariance_with_params: [0.0; 6],
             l_x_shift,
+            shifts: [0.0, 0.0, 0.0, l_x_shift, 0.0, 0.0],
             turning_speed: 0.3,
             turn_rate: 0.5,
             applied: false,
@@ -185,14 +206,27 @@ mod tests {
     }
 
     #[test]
-    fn only_an_outward_significant_slide_that_moves_lx_is_found() {
-        let sigma_l_x = 0.001;
-        assert!(found(&slip(0.05, 0.01, 0.005), sigma_l_x));
+    fn only_an_outward_significant_slide_that_moves_a_parameter_is_found() {
+        // σ: 1 mm for the distances, 2 mrad for ℓθ.
+        let mut cov = [[0.0; 6]; 6];
+        for (i, row) in cov.iter_mut().enumerate() {
+            row[i] = if i == 5 { 4e-6 } else { 1e-6 };
+        }
+        assert!(found(&slip(0.05, 0.01, 0.005), &cov));
         // Inward: no wheel slides that way.
-        assert!(!found(&slip(-0.05, 0.01, -0.005), sigma_l_x));
+        assert!(!found(&slip(-0.05, 0.01, -0.005), &cov));
         // Below 4σ.
-        assert!(!found(&slip(0.035, 0.01, 0.005), sigma_l_x));
-        // Significant but moving ℓx by less than its σ.
-        assert!(!found(&slip(0.05, 0.01, 0.0005), sigma_l_x));
+        assert!(!found(&slip(0.035, 0.01, 0.005), &cov));
+        // Significant but moving ℓx by less than its σ, and nothing else.
+        assert!(!found(&slip(0.05, 0.01, 0.0005), &cov));
+        // ℓx barely, ℓθ by 3σ: found (the rover's heading in its arcs).
+        let mut s = slip(0.05, 0.01, 0.0005);
+        s.shifts[5] = 0.006;
+        assert!(found(&s, &cov));
+        assert_eq!(matters(&s, &cov).map(|(i, _)| i), Some(5));
+        // A held parameter (zero variance) does not count.
+        let mut held = cov;
+        held[5][5] = 0.0;
+        assert!(!found(&s, &held));
     }
 }

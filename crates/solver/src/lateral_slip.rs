@@ -44,6 +44,10 @@ pub struct LateralSlip {
     /// ℓx with the slide estimated minus ℓx without it (m): what ignoring the
     /// slide moves ℓx by.
     pub l_x_shift: f64,
+    /// Every parameter with the slide estimated minus without it (SI units, order
+    /// r_L, r_R, b, ℓx, ℓy, ℓθ; `l_x_shift` is the fourth): what ignoring the slide
+    /// moves each by.
+    pub shifts: [f64; 6],
     /// Median forward speed |v| (m/s) of the samples that turn while translating
     /// (|ω| above 0.1 rad/s, |v| above 0.02 m/s); NaN without such samples.
     pub turning_speed: f64,
@@ -62,6 +66,16 @@ impl LateralSlip {
         } else {
             f64::INFINITY
         }
+    }
+
+    /// The parameter that ignoring the slide moves most in units of its σ in
+    /// `covariance` (the six-parameter estimate's): its index and `|shift| / σ`
+    /// (held parameters, with zero variance, left out); `None` when none moves.
+    pub fn largest_shift(&self, covariance: &[[f64; 6]; 6]) -> Option<(usize, f64)> {
+        (0..6)
+            .filter(|&i| covariance[i][i] > 0.0 && self.shifts[i] != 0.0)
+            .map(|i| (i, self.shifts[i].abs() / covariance[i][i].sqrt()))
+            .max_by(|a, b| a.1.total_cmp(&b.1))
     }
 
     /// The slip angle `atan(k·ω)` (degrees) at a turn rate `omega` (rad/s): the angle
@@ -275,6 +289,10 @@ pub fn fit_lateral_slip(
             sigma: var_k.sqrt(),
             covariance_with_params: cross,
             l_x_shift: params.laser.x - calibration.params.laser.x,
+            shifts: {
+                let (with, without) = (params.to_vector(), calibration.params.to_vector());
+                std::array::from_fn(|i| with[i] - without[i])
+            },
             turning_speed: median(speeds),
             turn_rate: median(rates),
             applied: false,
