@@ -139,13 +139,14 @@ fn the_command_line_chooses_the_model() {
 }
 
 #[test]
-fn the_real_mines_logs_leave_the_slide_undetermined_and_say_so() {
+fn the_real_mines_logs_show_the_slide_and_say_so() {
     // The real MinesRover logs (read from ../shared/real/mines beside the repository,
-    // skipped with a notice when absent): k is 2.5σ on exp1 and −1.3σ on exp2, so the
-    // default keeps the six-parameter estimate, and exp1 gets a note naming
-    // --lateral-slip (the slide would move its ℓx by more than its σ); whether exp2
-    // gets one depends on how many of its pairs the matcher keeps, so it is printed,
-    // not asserted. Estimated, the two logs' k agree within 3σ.
+    // skipped with a notice when absent). Since the pairs in turns are matched through
+    // the scans between them (odocal_pipeline::chained), both logs show an outward
+    // slide of one size: k 0.058 ± 0.021 s on exp1 (2.8σ: estimated as a precaution,
+    // it moves ℓx by 34 mm) and 0.058 ± 0.033 s on exp2 (1.8σ: a note naming
+    // --lateral-slip). Before, 0.044 ± 0.017 and −0.053 ± 0.041. Each log gets a
+    // finding that says so; estimated, the two logs' k agree within 3σ.
     let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/real/mines");
     let mut slides = Vec::new();
     for name in ["exp1.log", "exp2.log"] {
@@ -156,19 +157,27 @@ fn the_real_mines_logs_leave_the_slide_undetermined_and_say_so() {
         }
         let auto = calibrate(&path, &with_model(SlideModel::Auto));
         let slip = auto.lateral_slip.expect("the slide is checked");
-        assert!(!slip.applied, "{name}: {slip:?}");
-        let noted = auto
+        let said = auto
             .health
             .iter()
-            .any(|f| f.kind == FindingKind::LateralSlip && f.message.contains("--lateral-slip"));
+            .find(|f| f.kind == FindingKind::LateralSlip)
+            .map(|f| f.message.clone())
+            .unwrap_or_default();
         println!(
-            "{name}: k {:.4} ± {:.4} s, ℓx shift {:.1} mm, noted: {noted}",
+            "{name}: k {:.4} ± {:.4} s, ℓx shift {:.1} mm, applied {}: {said}",
             slip.k,
             slip.sigma,
-            slip.l_x_shift * 1e3
+            slip.l_x_shift * 1e3,
+            slip.applied
         );
+        assert!(slip.k > 0.0, "{name}: {slip:?}");
+        if slip.applied {
+            assert!(said.contains("--no-lateral-slip"), "{name}: {said}");
+        } else {
+            assert!(said.contains("--lateral-slip"), "{name}: {said}");
+        }
         if name == "exp1.log" {
-            assert!(noted, "{name}: {slip:?}");
+            assert!(slip.applied, "{name}: {slip:?}");
         }
         let estimated = calibrate(&path, &with_model(SlideModel::Estimate));
         slides.push(estimated.lateral_slip.expect("the slide is estimated"));
