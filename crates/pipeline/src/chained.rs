@@ -1,9 +1,9 @@
 //! Pairs the matcher refused, matched again through the scans between them.
 //!
 //! A pair `(a, b)` is refused mostly because its two scans see too little of one
-//! scene (a fast robot, sparse returns, people walking through): on the real
-//! MinesRover logs, scans 0.4 s apart share 60–70 % of their points where scans
-//! 0.1 s apart share 90 %. Such a pair is split at its middle scan `m` and the
+//! scene (a fast robot, a turn, sparse returns, people walking through): on the real
+//! MinesRover logs, scans 0.4 s apart share 60–70 % of their points, and neighbouring
+//! scans 0.1 s apart match far more often. Such a pair is split at its middle scan `m` and the
 //! halves `(a, m)`, `(m, b)` are matched, each from the odometry guess of its own
 //! interval; a half that is refused is split again, down to [`MAX_LINKS`] links of
 //! at least one scan period. When every link is accepted, the pair's ŝ is their
