@@ -82,7 +82,7 @@ impl LinkSource<'_> {
 
 /// Matches the pairs refused in `results` (one per pair of `pairs`, in time order)
 /// through their intermediate scans, and replaces each one whose chain is accepted
-/// by the composed match; returns how many were. `scans` are the scans the pairs
+/// by the composed match (its `links` above 1 say so). `scans` are the scans the pairs
 /// were matched on: with `compensated` (swept scans compensated with
 /// `source.params`) the scans between the two of a refused pair are compensated into
 /// them first, and a pair whose scans between cannot be is left refused.
@@ -93,13 +93,13 @@ pub fn rescue_refused(
     pairs: &[(usize, usize)],
     results: &mut [Result<MatchStats, MatchFailure>],
     params: &IcpParams,
-) -> usize {
+) {
     let mut refused: Vec<usize> = (0..pairs.len())
         .filter(|&k| matches!(&results[k], Err(f) if worth_chaining(f)))
         .filter(|&k| pairs[k].1 >= pairs[k].0 + 2)
         .collect();
     if refused.is_empty() {
-        return 0;
+        return;
     }
     if compensated {
         match source.params {
@@ -120,21 +120,18 @@ pub fn rescue_refused(
                     })
                 });
             }
-            None => return 0,
+            None => return,
         }
     }
     let predictor = source.params.map(|p| Predictor::new(p, source.use_profile));
     let chained_pairs: Vec<(usize, usize)> = refused.iter().map(|&k| pairs[k]).collect();
     let guess = |i: usize, j: usize| source.guess(predictor.as_ref(), i, j);
     let chained = match_through_intermediate_scans(scans, &chained_pairs, &guess, params);
-    let mut rescued = 0;
     for (k, m) in refused.into_iter().zip(chained) {
         if let Some(m) = m {
             results[k] = Ok(m);
-            rescued += 1;
         }
     }
-    rescued
 }
 
 /// One piece of a pair's chain: its two scans and, once matched, the result.
