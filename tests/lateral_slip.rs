@@ -65,6 +65,89 @@ fn a_sliding_pioneer_biases_lx_unless_the_slide_is_estimated() {
 }
 
 #[test]
+fn several_logs_of_a_sliding_robot_share_one_slide() {
+    // Two 120 s logs of the sliding Pioneer calibrated together: the joint model has
+    // the slide too (one robot, one k), so the joint ℓx is not the biased one.
+    use odocal_log::{read_log, ReadOptions};
+    use odocal_pipeline::{calibrate_logs, NoProgress};
+    let made: Vec<_> = [33, 34]
+        .iter()
+        .map(|&seed| {
+            simulated_log(&format!("skid-joint-{seed}"), "pioneer", 120.0, seed, |c| {
+                c.motors.lateral_slip = K;
+            })
+        })
+        .collect();
+    let logs: Vec<_> = made
+        .iter()
+        .map(|(p, _)| read_log(p, &ReadOptions::default()).expect("the log reads"))
+        .collect();
+    let named: Vec<(&str, &odocal_log::Log)> = logs.iter().map(|l| ("sim", l)).collect();
+    let truth = made[0].1;
+    assert_eq!(truth, made[1].1, "one robot");
+    let joint = |model| {
+        calibrate_logs(&named, &with_model(model), &NoProgress)
+            .expect("the joint calibration")
+            .joint
+    };
+    let error = |o: &odocal_pipeline::Outcome, i: usize| {
+        let c = &o.calibration;
+        (c.params.to_vector()[i] - truth[i]) / c.covariance[i][i].sqrt()
+    };
+    let plain = joint(SlideModel::Off);
+    let auto = joint(SlideModel::Auto);
+    let slip = auto.calibration.lateral_slip.expect("the slide is checked");
+    println!(
+        "joint ℓx: {:+.2}σ without the slide, {:+.2}σ with it; k = {:.4} ± {:.4} s",
+        error(&plain, 3),
+        error(&auto, 3),
+        slip.k,
+        slip.sigma
+    );
+    assert!(
+        error(&plain, 3).abs() > 3.0,
+        "without the slide ℓx is biased"
+    );
+    assert!(slip.applied, "{slip:?}");
+    assert!((slip.k - K).abs() < 3.0 * slip.sigma, "{slip:?}");
+    let errors = |o| {
+        (0..6)
+            .map(|i| format!("{:+.2}", error(o, i)))
+            .collect::<Vec<_>>()
+    };
+    println!(
+        "errors/σ: without {:?}, with {:?}",
+        errors(&plain),
+        errors(&auto)
+    );
+    for i in 0..6 {
+        assert!(
+            error(&auto, i).abs() < 3.0,
+            "parameter {i}: {:+.2}σ",
+            error(&auto, i)
+        );
+    }
+    assert!(
+        auto.health
+            .iter()
+            .any(|f| f.kind == FindingKind::LateralSlip
+                && f.message.starts_with("the logs together: ")),
+        "the joint slide is said"
+    );
+    // Two lasers (the second log's its own): the joint model has no slide term, so
+    // nothing is "well determined" and the refusal says why, with no parameter to hold.
+    let (a, b) = (made[0].0.to_str().unwrap(), made[1].0.to_str().unwrap());
+    let lasers = common::odocal(&["calibrate", a, b, "--own-laser", "2"]);
+    let said = common::stderr(&lasers);
+    assert!(!lasers.status.success(), "{said}");
+    assert!(said.contains("has no slide term"), "{said}");
+    assert!(!said.contains("--fix"), "{said}");
+    for (p, _) in &made {
+        cleanup(p);
+    }
+}
+
+#[test]
 fn the_mines_rover_lx_is_within_3_sigma() {
     for seed in [1, 2] {
         let (path, truth) = simulated_log("skid-rover", "mines-rover", 120.0, seed, |_| {});
@@ -131,10 +214,33 @@ fn the_command_line_chooses_the_model() {
     let both = odocal(&["calibrate", &log, "--lateral-slip", "--no-lateral-slip"]);
     assert!(!both.status.success());
     assert!(common::stderr(&both).contains("cannot be used with"));
-    // Several logs are solved with six parameters: asked for the slide, refused.
-    let joint = odocal(&["calibrate", &log, &log, "--lateral-slip"]);
-    assert!(!joint.status.success());
-    assert!(common::stderr(&joint).contains("calibrate each log alone"));
+    // Several logs of one laser share the slide: estimated jointly, as asked.
+    let joint = odocal(&[
+        "calibrate",
+        &log,
+        &log,
+        "--lateral-slip",
+        "--json",
+        "--accept-weak",
+    ]);
+    assert!(joint.status.success(), "{}", common::stderr(&joint));
+    let joint: serde_json::Value = serde_json::from_slice(&joint.stdout).unwrap();
+    assert_eq!(joint["lateral_slip"]["applied"], true, "{joint}");
+    // Several lasers have no slide term: asked for it, refused by name.
+    let lasers = odocal(&[
+        "calibrate",
+        &log,
+        &log,
+        "--own-laser",
+        "2",
+        "--lateral-slip",
+    ]);
+    assert!(!lasers.status.success());
+    assert!(
+        common::stderr(&lasers).contains("calibrate each laser's log alone"),
+        "{}",
+        common::stderr(&lasers)
+    );
     cleanup(&dir.join("run"));
 }
 
@@ -189,4 +295,57 @@ fn the_real_mines_logs_show_the_slide_and_say_so() {
         a.k, a.sigma, b.k, b.sigma
     );
     assert!(z.abs() < 3.0);
+}
+
+#[test]
+fn the_real_mines_logs_together_estimate_one_slide() {
+    // Both real MinesRover logs in one calibration (skipped with a notice when
+    // absent): measured k 0.061 ± 0.017 s together (0.058 on each log alone), and ℓx
+    // 157.6 ± 13.1 mm with the slide; before the joint solve had the slide, 121.5 ±
+    // 8.1 mm "well determined" (115.3 ± 8.9 mm with --no-lateral-slip). The robot's
+    // nominal mounting: 145 mm.
+    use odocal_pipeline::{calibrate_logs, NoProgress};
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/real/mines");
+    let mut logs = Vec::new();
+    for name in ["exp1.log", "exp2.log"] {
+        let path = dir.join(name);
+        if !path.exists() {
+            println!("skipped: {} is absent", path.display());
+            return;
+        }
+        logs.push(odocal_log::read_log(&path, &Default::default()).expect("the log reads"));
+    }
+    let named: Vec<(&str, &odocal_log::Log)> = vec![("exp1.log", &logs[0]), ("exp2.log", &logs[1])];
+    let run = |model| calibrate_logs(&named, &with_model(model), &NoProgress).expect("joint");
+    let auto = run(SlideModel::Auto);
+    let plain = run(SlideModel::Off);
+    let slip = auto
+        .joint
+        .calibration
+        .lateral_slip
+        .expect("checked jointly");
+    let l_x = |o: &odocal_pipeline::Outcome| {
+        let c = &o.calibration;
+        (c.params.laser.x, c.covariance[3][3].sqrt())
+    };
+    let ((with, s_with), (without, s_without)) = (l_x(&auto.joint), l_x(&plain.joint));
+    println!(
+        "together: k {:.4} ± {:.4} s; ℓx {:.1} ± {:.1} mm with the slide, {:.1} ± {:.1} mm \
+         without",
+        slip.k,
+        slip.sigma,
+        1e3 * with,
+        1e3 * s_with,
+        1e3 * without,
+        1e3 * s_without
+    );
+    assert!(slip.applied, "{slip:?}");
+    for own in &auto.logs {
+        let k = own.calibration.lateral_slip.expect("checked on each log");
+        assert!(
+            (k.k - slip.k).abs() < 3.0 * k.sigma,
+            "{k:?} against {slip:?}"
+        );
+    }
+    assert!(with - without > s_with, "the slide moves the joint ℓx");
 }

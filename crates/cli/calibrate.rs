@@ -86,6 +86,7 @@ pub struct Args {
     pub icp_covariance: bool,
     /// Skid-steer robot: estimate the sideways slide in turns (v_y = −k·v·ω) as a
     /// seventh parameter, always (by default it is estimated when the data show it).
+    /// Several logs of one laser share one slide; not with several lasers.
     #[arg(long, conflicts_with = "no_lateral_slip")]
     pub lateral_slip: bool,
     /// Differential drive only: neither check for the sideways slide in turns nor
@@ -211,11 +212,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let t_parse = Instant::now();
     let files = input.paths();
     check_own_laser(&args.own_laser, files.len())?;
-    if args.lateral_slip && (files.len() > 1 || input.read.scan_topic.len() > 1) {
+    if args.lateral_slip && (input.read.scan_topic.len() > 1 || !args.own_laser.is_empty()) {
         anyhow::bail!(
-            "--lateral-slip estimates the slide for one log with one laser; several logs or \
-             lasers are calibrated with the six-parameter model only: calibrate each log \
-             alone (`odocal calibrate {} --lateral-slip`)",
+            "--lateral-slip estimates the slide with one laser's six parameters (several \
+             logs of one laser share it); several lasers are calibrated with the \
+             six-parameter model only: calibrate each laser's log alone (`odocal calibrate \
+             {} --lateral-slip`)",
             files
                 .first()
                 .map_or_else(|| "LOG".into(), |p| p.display().to_string())

@@ -110,8 +110,8 @@ pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> 
         });
     };
     let numbers = format!(
-        "v_y = −k·v·ω with k = {:.3} ± {:.3} s (a {:.1}° slip angle at 1 rad/s; at this \
-         log's typical turn, {:.2} m/s and {:.2} rad/s, {:.0} mm/s sideways)",
+        "v_y = −k·v·ω with k = {:.3} ± {:.3} s (a {:.1}° slip angle at 1 rad/s; at the \
+         data's typical turn, {:.2} m/s and {:.2} rad/s, {:.0} mm/s sideways)",
         slip.k,
         slip.sigma,
         slip.slip_angle_deg(1.0),

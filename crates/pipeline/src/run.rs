@@ -322,6 +322,7 @@ pub fn synchronize_and_match(
         read_time_sigma: None,
         unrepaired_timing: None,
         heading_not_from_wheels: None,
+        unmodelled_slide: None,
     })
 }
 
@@ -462,10 +463,22 @@ pub(crate) fn refuse_poorly_determined(
                 p.verdict = Verdict::Weak;
             }
         }
-        let short = match (&synced.unrepaired_timing, &synced.heading_not_from_wheels) {
-            (Some(timing), Some(_)) => format!("{timing}; {}", health::gyro_heading::CAUSE),
-            (None, Some(_)) => health::gyro_heading::CAUSE.to_string(),
-            _ => cause.clone(),
+        let short = [
+            synced.unrepaired_timing.clone(),
+            synced
+                .heading_not_from_wheels
+                .as_ref()
+                .map(|_| health::gyro_heading::CAUSE.to_string()),
+            synced.unmodelled_slide.clone(),
+        ]
+        .into_iter()
+        .flatten()
+        .collect::<Vec<_>>()
+        .join("; ");
+        let short = if short.is_empty() {
+            cause.clone()
+        } else {
+            short
         };
         calibration.observability.sentence = format!("{short}; {}", would_give(synced, &sentence));
     }
@@ -553,8 +566,10 @@ pub(crate) fn refuse_poorly_determined(
 fn would_give(synced: &Synchronized, sentence: &str) -> String {
     let without = if synced.unrepaired_timing.is_some() {
         "with its own acquisition times"
-    } else {
+    } else if synced.heading_not_from_wheels.is_some() {
         "with a heading from the wheels"
+    } else {
+        "without the slide"
     };
     format!("{without} the motion would give: {sentence}")
 }

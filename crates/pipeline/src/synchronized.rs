@@ -43,16 +43,24 @@ pub struct Synchronized {
     /// (see [`crate::health::gyro_heading`]), in words: while it is set no parameter is
     /// judged well determined.
     pub heading_not_from_wheels: Option<String>,
+    /// A sideways slide in turns that the model solved cannot hold (several lasers
+    /// solved together, one of whose logs slides; see [`crate::lateral_slip`]), in
+    /// words: while it is set no parameter is judged well determined.
+    pub unmodelled_slide: Option<String>,
 }
 
 impl Synchronized {
     /// What keeps every verdict from "well determined" (unrepaired timing, a heading
-    /// not from the wheels), in words; `None` when nothing does.
+    /// not from the wheels, a slide not modelled), in words; `None` when nothing does.
     pub fn unjudgeable(&self) -> Option<String> {
-        let causes: Vec<&str> = [&self.unrepaired_timing, &self.heading_not_from_wheels]
-            .into_iter()
-            .filter_map(|c| c.as_deref())
-            .collect();
+        let causes: Vec<&str> = [
+            &self.unrepaired_timing,
+            &self.heading_not_from_wheels,
+            &self.unmodelled_slide,
+        ]
+        .into_iter()
+        .filter_map(|c| c.as_deref())
+        .collect();
         (!causes.is_empty()).then(|| causes.join("; "))
     }
 }
