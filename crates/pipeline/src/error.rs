@@ -1,6 +1,7 @@
 //! Why the pipeline could not produce a calibration, in one sentence each.
 
-use crate::sync::DiscardCounts;
+use crate::rejection::RejectionCounts;
+use crate::sync::{DiscardCounts, DiscardReason};
 use odocal_log::LogError;
 use odocal_solver::SolveError;
 
@@ -13,8 +14,9 @@ pub enum PipelineError {
     /// Too few scan pairs survived synchronization and matching.
     #[error(
         "only {usable} usable sample(s) out of {pairs} scan pairs (discarded: {}); at least \
-         {needed} are needed — drive longer, or check the encoder stream and the scans",
-        describe_discards(.discarded)
+         {needed} are needed{}",
+        describe_discards(.discarded),
+        why_too_few(.discarded, .match_rejections)
     )]
     TooFewSamples {
         /// Samples that survived.
@@ -25,6 +27,9 @@ pub enum PipelineError {
         needed: usize,
         /// Discarded pairs per reason.
         discarded: DiscardCounts,
+        /// Of the pairs discarded because the matcher refused them, how many per
+        /// reason.
+        match_rejections: RejectionCounts,
     },
     /// The solver refused (not excited, too few samples after trimming, …).
     #[error(transparent)]
@@ -111,10 +116,12 @@ impl PipelineError {
                 pairs,
                 needed,
                 discarded,
+                match_rejections,
             } => format!(
                 "only {usable} usable sample(s) remain out of {pairs} scan pairs (discarded: \
-                 {}; at least {needed} are needed)",
-                describe_discards(discarded)
+                 {}; at least {needed} are needed){}",
+                describe_discards(discarded),
+                why_too_few(discarded, match_rejections)
             ),
             other => other.to_string(),
         };
@@ -172,6 +179,60 @@ fn also_found(faults: &Option<String>) -> String {
     })
 }
 
+/// Why so few pairs remain, and what to do: the matcher's refusals by reason with the
+/// advice for the most common one when matching lost most pairs; else what the
+/// largest discard says about the recording.
+fn why_too_few(d: &DiscardCounts, rejections: &RejectionCounts) -> String {
+    let largest = [
+        DiscardReason::MatchFailed,
+        DiscardReason::RobotStill,
+        DiscardReason::EncoderGap,
+        DiscardReason::IntervalTooLong,
+    ]
+    .into_iter()
+    .map(|r| (r, d.get(r)))
+    .filter(|&(_, n)| n > 0)
+    .max_by_key(|&(_, n)| n);
+    match largest {
+        Some((DiscardReason::MatchFailed, failed)) => {
+            let Some((reason, n)) = rejections.most_common() else {
+                return format!(
+                    ": the scan matcher refused {failed} pairs; check the scans (`odocal info \
+                     LOG`)"
+                );
+            };
+            let by_reason: Vec<String> = rejections
+                .0
+                .iter()
+                .filter(|(_, n)| **n > 0)
+                .map(|(k, n)| format!("{k} {n}"))
+                .collect();
+            format!(
+                ": the scan matcher refused {failed} pairs ({}); most often {} ({n}): {}",
+                by_reason.join(", "),
+                reason.key(),
+                reason.advice()
+            )
+        }
+        Some((DiscardReason::RobotStill, _)) => {
+            ": the robot stood still through most of the log; record it driving (straights, \
+             arcs and spins in place)"
+                .into()
+        }
+        Some((DiscardReason::EncoderGap, _)) => {
+            ": the wheel counts do not cover most scan pairs; check the encoder stream (its \
+             rate and gaps: `odocal info LOG`)"
+                .into()
+        }
+        Some((DiscardReason::IntervalTooLong, _)) => {
+            ": most scan pairs lie further apart in time than their stride allows (scans \
+             missing from the log); check the laser's rate and driver (`odocal info LOG`)"
+                .into()
+        }
+        _ => " — drive longer, or check the encoder stream and the scans".into(),
+    }
+}
+
 fn describe_discards(d: &DiscardCounts) -> String {
     let parts: Vec<String> =
         d.0.iter()
@@ -182,5 +243,69 @@ fn describe_discards(d: &DiscardCounts) -> String {
         "none".into()
     } else {
         parts.join(", ")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rejection::Rejection;
+
+    fn too_few(discards: &[(DiscardReason, usize)], refused: &[(Rejection, usize)]) -> String {
+        let mut discarded = DiscardCounts::default();
+        for &(r, n) in discards {
+            for _ in 0..n {
+                discarded.add(r);
+            }
+        }
+        let mut match_rejections = RejectionCounts::default();
+        for &(r, n) in refused {
+            for _ in 0..n {
+                match_rejections.add(r);
+            }
+        }
+        PipelineError::TooFewSamples {
+            usable: 3,
+            pairs: 299,
+            needed: 20,
+            discarded,
+            match_rejections,
+        }
+        .to_string()
+    }
+
+    #[test]
+    fn too_few_samples_names_what_lost_the_pairs_and_what_to_do() {
+        // A sparse laser's log (the simulated Neato, seed 101): matching lost them.
+        let said = too_few(
+            &[(DiscardReason::MatchFailed, 296)],
+            &[
+                (Rejection::Conditioning, 132),
+                (Rejection::Correspondences, 103),
+                (Rejection::Overlap, 31),
+            ],
+        );
+        assert!(
+            said.contains("the scan matcher refused 296 pairs (conditioning 132, correspondences 103, overlap 31); most often conditioning (132)"),
+            "{said}"
+        );
+        assert!(said.contains(Rejection::Conditioning.advice()), "{said}");
+        // A robot that hardly moved.
+        let said = too_few(
+            &[
+                (DiscardReason::RobotStill, 250),
+                (DiscardReason::MatchFailed, 40),
+            ],
+            &[(Rejection::Overlap, 40)],
+        );
+        assert!(said.contains("stood still"), "{said}");
+        assert!(!said.contains("most often"), "{said}");
+        // Wheel counts missing, scans missing.
+        let said = too_few(&[(DiscardReason::EncoderGap, 280)], &[]);
+        assert!(said.contains("check the encoder stream"), "{said}");
+        let said = too_few(&[(DiscardReason::IntervalTooLong, 280)], &[]);
+        assert!(said.contains("scans missing"), "{said}");
+        // Nothing discarded: the log is short.
+        assert!(too_few(&[], &[]).contains("drive longer"));
     }
 }

@@ -155,6 +155,7 @@ pub fn calibrate_logs_with_lasers(
             pairs: synced.pairs,
             needed: MIN_SAMPLES,
             discarded: synced.discarded,
+            match_rejections: synced.match_rejections,
         }));
     }
     let solve_options = crate::matcher_bias::with_matcher_bias(opts.solve_options(), &synced);

@@ -414,6 +414,7 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
             pairs: synced.pairs,
             needed: MIN_SAMPLES,
             discarded: synced.discarded.clone(),
+            match_rejections: synced.match_rejections.clone(),
         });
     }
     let samples: Vec<_> = synced
