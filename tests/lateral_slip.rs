@@ -300,10 +300,10 @@ fn the_real_mines_logs_show_the_slide_and_say_so() {
 #[test]
 fn the_real_mines_logs_together_estimate_one_slide() {
     // Both real MinesRover logs in one calibration (skipped with a notice when
-    // absent): measured k 0.061 ± 0.017 s together (0.058 on each log alone), and ℓx
-    // 157.6 ± 13.1 mm with the slide; before the joint solve had the slide, 121.5 ±
-    // 8.1 mm "well determined" (115.3 ± 8.9 mm with --no-lateral-slip). The robot's
-    // nominal mounting: 145 mm.
+    // absent): measured k 0.065 ± 0.017 s together (0.065 ± 0.020 and 0.049 ± 0.037
+    // on each log alone), and ℓx 151.5 ± 13.2 mm with the slide, 113.6 ± 8.1 mm with
+    // --no-lateral-slip; before the joint solve had the slide it gave 121.5 ± 8.1 mm
+    // "well determined". The robot's nominal mounting: 145 mm.
     use odocal_pipeline::{calibrate_logs, NoProgress};
     let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/real/mines");
     let mut logs = Vec::new();

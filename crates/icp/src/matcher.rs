@@ -64,7 +64,10 @@ pub struct IcpResult {
     /// floor for exact data; see [`IcpParams::max_residual_to_noise`].
     pub noise_sigma: f64,
     /// Correspondences used in the final step per valid point of the current scan on
-    /// a usable local line (at most 1).
+    /// a usable local line (at most 1). When that falls short of
+    /// [`IcpParams::min_matched_share`], per such point the reference could have
+    /// matched: its nearest reference point within the correspondence gate has a
+    /// local line, or it has none within the gate (free space counts against a match).
     pub matched_share: f64,
     /// Starting points tried: 1 when the first guess led to the result.
     pub starts: u32,
@@ -583,6 +586,18 @@ impl Matcher {
             matched_share: (used as f64 / current.lined_count.max(1) as f64).min(1.0),
             starts: 1,
         };
+        let result = if result.matched_share < params.min_matched_share {
+            // Short of the share: leave out of it the current points that land where
+            // the reference scan itself has no line (a reading it lost, an edge): the
+            // current scan's own such points are not counted either.
+            let matchable = self.matchable_lined(reference, current, &estimate, gate2, use_tree);
+            IcpResult {
+                matched_share: (used as f64 / matchable.max(1) as f64).min(1.0),
+                ..result
+            }
+        } else {
+            result
+        };
         check_consistency(&result, params)?;
         Ok(result)
     }
@@ -599,6 +614,41 @@ impl Matcher {
             equations.add(c.q, c.normal, c.offset, c.weight);
         }
         equations
+    }
+
+    /// The current scan's points with a local line of their own, less those whose
+    /// nearest reference point at `estimate` (within the correspondence gate) has
+    /// none: the points the reference could have matched. Points with no reference
+    /// point within the gate stay counted (a wrong alignment puts points there).
+    fn matchable_lined(
+        &mut self,
+        reference: &PreparedScan,
+        current: &PreparedScan,
+        estimate: &Pose2,
+        gate2: f64,
+        use_tree: bool,
+    ) -> usize {
+        let (s, c) = estimate.theta.sin_cos();
+        let mut count = 0;
+        for (k, &i) in current.valid_indices.iter().enumerate() {
+            if current.incidence_cos[i as usize].is_nan() {
+                continue;
+            }
+            let q = current.points[i as usize];
+            let p = [
+                estimate.x + c * q[0] - s * q[1],
+                estimate.y + s * q[0] + c * q[1],
+            ];
+            let nearest = if use_tree {
+                nearest_by_tree(reference, p, gate2)
+            } else {
+                nearest_by_angle(reference, p, self.search_start[k] as usize, gate2)
+            };
+            if nearest.is_none_or(|j| !reference.incidence_cos[j].is_nan()) {
+                count += 1;
+            }
+        }
+        count
     }
 
     /// Fills `self.correspondences` for the estimate.

@@ -100,7 +100,11 @@ pub struct IcpParams {
     /// Consistency test: a match using fewer than this share of the current scan's
     /// valid points on a usable local line is refused. On simulated URG-04LX pairs 0.4 s apart right matches
     /// use 86–100 %, translations slid along a wall to a wrong but equally tight
-    /// alignment 29–60 %.
+    /// alignment 29–60 %. Points landing where the reference has no local line
+    /// (clutter, mixed pixels) are left out of the share, as the current scan's own
+    /// are ([`crate::IcpResult::matched_share`]): on the realistic TurtleBot 4 preset
+    /// (seed 2, every pair matched from its true displacement) 415 of 920 pairs fell
+    /// at 51–69 % of all its points, most of them right.
     pub min_matched_share: f64,
     /// When the match from the first guess fails or is refused, it is tried again from
     /// up to this many other starting rotations: the best agreements of the two scans'
