@@ -1,6 +1,6 @@
 //! Why the pipeline could not produce a calibration, in one sentence each.
 
-use crate::rejection::RejectionCounts;
+use crate::rejection::{Rejection, RejectionCounts};
 use crate::sync::{DiscardCounts, DiscardReason};
 use odocal_log::LogError;
 use odocal_solver::SolveError;
@@ -16,7 +16,7 @@ pub enum PipelineError {
         "only {usable} usable sample(s) out of {pairs} scan pairs (discarded: {}); at least \
          {needed} are needed{}",
         describe_discards(.discarded),
-        why_too_few(.discarded, .match_rejections)
+        why_too_few(.discarded, .match_rejections, *.scan_returns)
     )]
     TooFewSamples {
         /// Samples that survived.
@@ -30,6 +30,8 @@ pub enum PipelineError {
         /// Of the pairs discarded because the matcher refused them, how many per
         /// reason.
         match_rejections: RejectionCounts,
+        /// The scans' median returns and rays per scan, when known.
+        scan_returns: Option<crate::matching::ScanReturns>,
     },
     /// The solver refused (not excited, too few samples after trimming, …).
     #[error(transparent)]
@@ -117,11 +119,12 @@ impl PipelineError {
                 needed,
                 discarded,
                 match_rejections,
+                scan_returns,
             } => format!(
                 "only {usable} usable sample(s) remain out of {pairs} scan pairs (discarded: \
                  {}; at least {needed} are needed){}",
                 describe_discards(discarded),
-                why_too_few(discarded, match_rejections)
+                why_too_few(discarded, match_rejections, *scan_returns)
             ),
             other => other.to_string(),
         };
@@ -182,7 +185,11 @@ fn also_found(faults: &Option<String>) -> String {
 /// Why so few pairs remain, and what to do: the matcher's refusals by reason with the
 /// advice for the most common one when matching lost most pairs; else what the
 /// largest discard says about the recording.
-fn why_too_few(d: &DiscardCounts, rejections: &RejectionCounts) -> String {
+fn why_too_few(
+    d: &DiscardCounts,
+    rejections: &RejectionCounts,
+    scan_returns: Option<crate::matching::ScanReturns>,
+) -> String {
     let largest = [
         DiscardReason::MatchFailed,
         DiscardReason::RobotStill,
@@ -207,8 +214,21 @@ fn why_too_few(d: &DiscardCounts, rejections: &RejectionCounts) -> String {
                 .filter(|(_, n)| **n > 0)
                 .map(|(k, n)| format!("{k} {n}"))
                 .collect();
+            // Sparse scans explain refusals for too few correspondences, an unfixed
+            // direction or unusable scans: the numbers say so.
+            let sparse = match (reason, scan_returns) {
+                (
+                    Rejection::Correspondences | Rejection::Conditioning | Rejection::Scan,
+                    Some(crate::matching::ScanReturns { median, rays }),
+                ) if rays > 0 && 2 * median < rays => format!(
+                    " (this log's scans have a median of {median} returns of {rays} rays: \
+                     a sparse laser sees little of the scene, so drive near walls and \
+                     furniture in every direction)"
+                ),
+                _ => String::new(),
+            };
             format!(
-                ": the scan matcher refused {failed} pairs ({}); most often {} ({n}): {}",
+                ": the scan matcher refused {failed} pairs ({}); most often {} ({n}): {}{sparse}",
                 by_reason.join(", "),
                 reason.key(),
                 reason.advice()
@@ -249,7 +269,6 @@ fn describe_discards(d: &DiscardCounts) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rejection::Rejection;
 
     fn too_few(discards: &[(DiscardReason, usize)], refused: &[(Rejection, usize)]) -> String {
         let mut discarded = DiscardCounts::default();
@@ -270,6 +289,10 @@ mod tests {
             needed: 20,
             discarded,
             match_rejections,
+            scan_returns: Some(crate::matching::ScanReturns {
+                median: 69,
+                rays: 361,
+            }),
         }
         .to_string()
     }
@@ -290,6 +313,10 @@ mod tests {
             "{said}"
         );
         assert!(said.contains(Rejection::Conditioning.advice()), "{said}");
+        assert!(
+            said.contains("a median of 69 returns of 361 rays"),
+            "{said}"
+        );
         // A robot that hardly moved.
         let said = too_few(
             &[
@@ -299,6 +326,7 @@ mod tests {
             &[(Rejection::Overlap, 40)],
         );
         assert!(said.contains("stood still"), "{said}");
+        assert!(!said.contains("median of"), "{said}");
         assert!(!said.contains("most often"), "{said}");
         // Wheel counts missing, scans missing.
         let said = too_few(&[(DiscardReason::EncoderGap, 280)], &[]);

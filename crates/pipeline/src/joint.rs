@@ -156,6 +156,7 @@ pub fn calibrate_logs_with_lasers(
             needed: MIN_SAMPLES,
             discarded: synced.discarded,
             match_rejections: synced.match_rejections,
+            scan_returns: synced.scan_returns,
         }));
     }
     let solve_options = crate::matcher_bias::with_matcher_bias(opts.solve_options(), &synced);
@@ -430,6 +431,7 @@ fn merged(outcomes: &[Outcome]) -> Synchronized {
         },
         // Set by the joint solve when its model cannot hold a log's slide.
         unmodelled_slide: None,
+        scan_returns: first.scan_returns,
     }
 }
 

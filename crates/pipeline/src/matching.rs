@@ -29,6 +29,48 @@ pub struct MatchStats {
 /// Scans sampled to estimate the log's typical range noise.
 pub const NOISE_SAMPLE_SCANS: usize = 64;
 
+/// How many readings a log's scans return (see [`scan_returns`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ScanReturns {
+    /// The median count of readings within the scan's range limits.
+    pub median: u32,
+    /// The median count of rays per scan.
+    pub rays: u32,
+}
+
+/// The median count of readings within each scan's range limits, over every
+/// (len / [`NOISE_SAMPLE_SCANS`])-th scan of the store, and the median rays per scan
+/// of the same scans; `None` without scans.
+pub fn scan_returns(scans: &ScanStore) -> Option<ScanReturns> {
+    let every = (scans.len() / NOISE_SAMPLE_SCANS).max(1);
+    let (mut returns, mut rays): (Vec<usize>, Vec<usize>) = (0..scans.len())
+        .step_by(every)
+        .filter_map(|i| scans.get(i))
+        .map(|s| {
+            let (lo, hi) = (s.geometry.min_range, s.geometry.max_range);
+            let valid = s
+                .ranges
+                .iter()
+                .filter(|&&r| {
+                    let r = f64::from(r);
+                    r.is_finite() && r > lo && r < hi
+                })
+                .count();
+            (valid, s.ranges.len())
+        })
+        .unzip();
+    if returns.is_empty() {
+        return None;
+    }
+    let mid = returns.len() / 2;
+    returns.select_nth_unstable(mid);
+    rays.select_nth_unstable(mid);
+    Some(ScanReturns {
+        median: u32::try_from(returns[mid]).unwrap_or(u32::MAX),
+        rays: u32::try_from(rays[mid]).unwrap_or(u32::MAX),
+    })
+}
+
 /// The median range noise (σ, m) of up to [`NOISE_SAMPLE_SCANS`] scans spread evenly
 /// over the store, among those whose noise shows (straight stretches); 0 when none
 /// does. What the matcher's consistency test assumes for scans too cluttered or

@@ -323,6 +323,7 @@ pub fn synchronize_and_match(
         unrepaired_timing: None,
         heading_not_from_wheels: None,
         unmodelled_slide: None,
+        scan_returns: crate::matching::scan_returns(&log.scans),
     })
 }
 
@@ -415,6 +416,7 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
             needed: MIN_SAMPLES,
             discarded: synced.discarded.clone(),
             match_rejections: synced.match_rejections.clone(),
+            scan_returns: synced.scan_returns,
         });
     }
     let samples: Vec<_> = synced

@@ -47,6 +47,10 @@ pub struct Synchronized {
     /// solved together, one of whose logs slides; see [`crate::lateral_slip`]), in
     /// words: while it is set no parameter is judged well determined.
     pub unmodelled_slide: Option<String>,
+    /// The scans' returns: the median count of readings within the laser's range
+    /// per scan and the rays per scan (of the first log, with several), when any
+    /// scan was read; a refusal for too few matches names it.
+    pub scan_returns: Option<crate::matching::ScanReturns>,
 }
 
 impl Synchronized {
