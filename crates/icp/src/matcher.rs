@@ -639,16 +639,29 @@ impl Matcher {
                 estimate.x + c * q[0] - s * q[1],
                 estimate.y + s * q[0] + c * q[1],
             ];
-            let nearest = if use_tree {
-                nearest_by_tree(reference, p, gate2)
-            } else {
-                nearest_by_angle(reference, p, self.search_start[k] as usize, gate2)
-            };
+            let nearest = self.nearest_reference(reference, p, k, gate2, use_tree);
             if nearest.is_none_or(|j| !reference.incidence_cos[j].is_nan()) {
                 count += 1;
             }
         }
         count
+    }
+
+    /// The reference point nearest to `p` (current point `k` placed by the estimate)
+    /// within the gate: by the k-d tree, or by angle from the point's last match.
+    fn nearest_reference(
+        &self,
+        reference: &PreparedScan,
+        p: [f64; 2],
+        k: usize,
+        gate2: f64,
+        use_tree: bool,
+    ) -> Option<usize> {
+        if use_tree {
+            nearest_by_tree(reference, p, gate2)
+        } else {
+            nearest_by_angle(reference, p, self.search_start[k] as usize, gate2)
+        }
     }
 
     /// Fills `self.correspondences` for the estimate.
@@ -668,11 +681,7 @@ impl Matcher {
                 estimate.x + c * q[0] - s * q[1],
                 estimate.y + s * q[0] + c * q[1],
             ];
-            let nearest = if use_tree {
-                nearest_by_tree(reference, p, gate2)
-            } else {
-                nearest_by_angle(reference, p, self.search_start[k] as usize, gate2)
-            };
+            let nearest = self.nearest_reference(reference, p, k, gate2, use_tree);
             let Some(j) = nearest else { continue };
             self.search_start[k] = j as u32;
             let Some(seg) = segment_for(reference, p, j) else {

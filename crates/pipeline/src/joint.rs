@@ -137,7 +137,7 @@ pub fn calibrate_logs_with_lasers(
         outcomes.push(outcome);
     }
     let t = Instant::now();
-    let health: Vec<Finding> = logs
+    let mut health: Vec<Finding> = logs
         .iter()
         .zip(&outcomes)
         .flat_map(|((name, _), o)| {
@@ -167,7 +167,6 @@ pub fn calibrate_logs_with_lasers(
         .collect();
     let mut solved = solve(&samples, &laser_of, &solve_options, &lasers.constraints)
         .map_err(|e| JointError::Joint(PipelineError::from(e).with_faults(&health)))?;
-    let mut health = health;
     if solved.lasers.is_none() {
         // One robot, one slide: the logs' samples together determine `k` better than
         // any one log, and a slide left out of the joint model biases ℓx there as it
