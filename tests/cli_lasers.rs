@@ -96,12 +96,15 @@ fn a_bag_with_two_lidars_gives_one_wheel_calibration_and_two_poses() {
     // Both topics' samples are in the one solve; each log row is a topic.
     let rows = v["logs"].as_array().unwrap();
     assert_eq!(rows.len(), 2);
-    // The shared wheels are known at least as well as from either laser alone.
+    // The shared wheels are known at least as well as from either laser alone (to 1 %:
+    // each solve scales its σ by the noise its own residuals show; with the rear
+    // SICK-like laser's readings used to its 8 m, σ_b is 0.159 mm from it alone and
+    // 1.8 mm from the front LDS alone, so the joint solve can add almost nothing).
     let joint_b = v["sigma"][2].as_f64().unwrap();
     for r in rows {
         let own_b = r["own_sigma"][2].as_f64().unwrap();
         assert!(
-            joint_b <= own_b,
+            joint_b <= 1.01 * own_b,
             "σ_b joint {joint_b} vs {} alone {own_b}",
             r["path"]
         );
@@ -277,7 +280,7 @@ fn fix_and_prior_name_a_laser_with_at() {
         "--prior",
         "l_theta@2=3.1+-0.01",
         "--prior",
-        "b=0.1614+-0.0005",
+        "b=0.1614+-0.0001",
         "--json",
     ]);
     let v = json(&o);

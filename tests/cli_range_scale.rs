@@ -5,18 +5,8 @@
 
 mod common;
 
-use common::{cleanup, odocal, simulated_log, stderr};
+use common::{calibrate_json, cleanup, odocal, simulated_log, stderr};
 use serde_json::Value;
-
-/// `odocal calibrate ARGS --json`, parsed; panics with stderr when it fails.
-fn calibrate_json(args: &[&str]) -> Value {
-    let mut all = vec!["calibrate"];
-    all.extend_from_slice(args);
-    all.push("--json");
-    let o = odocal(&all);
-    assert!(o.status.success(), "{}", stderr(&o));
-    serde_json::from_slice(&o.stdout).expect("one JSON object")
-}
 
 fn array(v: &Value, key: &str) -> Vec<f64> {
     v.pointer(key)

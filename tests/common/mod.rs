@@ -76,3 +76,13 @@ pub fn odocal(args: &[&str]) -> std::process::Output {
 pub fn stderr(o: &std::process::Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
+
+/// `odocal calibrate ARGS --json`, parsed; panics with stderr when it fails.
+pub fn calibrate_json(args: &[&str]) -> serde_json::Value {
+    let mut all = vec!["calibrate"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    let o = odocal(&all);
+    assert!(o.status.success(), "{}", stderr(&o));
+    serde_json::from_slice(&o.stdout).expect("one JSON object")
+}

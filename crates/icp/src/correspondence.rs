@@ -252,9 +252,9 @@ mod tests {
     #[test]
     fn a_run_ending_at_a_range_jump_is_not_followed() {
         // The same wall, rays 90..100 seeing a far surface instead: an occlusion edge,
-        // whether the far readings are valid (3.5 m) or beyond the matcher's maximum
-        // reading (4.5 m, above IcpParams::max_reading).
-        for far in [3.5, 4.5] {
+        // whether the far readings are valid (3.5 m) or beyond the scan's maximum
+        // range (6 m, above its 5.6 m).
+        for far in [3.5, 6.0] {
             let scan = wall_with_gap(90..100, Some(far));
             let (p, j) = on_wall(&scan, -0.008);
             assert_eq!(j, 89, "{far}");

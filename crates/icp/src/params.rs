@@ -47,7 +47,10 @@ pub struct IcpParams {
     pub step_threshold_mult: f64,
     /// Readings at or below this range are invalid (m).
     pub min_reading: f64,
-    /// Readings at or above this range are invalid (m).
+    /// Readings at or above this range are invalid (m), as those at or above the
+    /// scan's own maximum range (the `max_range` given to [`crate::PreparedScan::new`])
+    /// are. ∞ by default: the scan's maximum alone (the pipeline gives each laser's
+    /// range up to its rated accuracy).
     pub max_reading: f64,
     /// Fail if the result is farther than this from the first guess (m).
     pub max_linear_correction: f64,
@@ -141,7 +144,7 @@ impl Default for IcpParams {
             outlier_sigma_mult: 4.0,
             step_threshold_mult: 3.0,
             min_reading: 0.02,
-            max_reading: 4.0,
+            max_reading: f64::INFINITY,
             max_linear_correction: 0.3,
             max_angular_correction: 50f64.to_radians(),
             line_fit_window: 7,

@@ -62,6 +62,11 @@ pub struct Options {
     /// `None`: the data sheet's of the range finder recognised in the log (see
     /// [`crate::range_finder`]), or none when it is not recognised.
     pub laser_range_scale: Option<f64>,
+    /// Scan matching uses the readings below this range (m), as stated by the user;
+    /// `None`: the range the laser is rated for
+    /// ([`crate::LaserSignature::matching_range`]). A scan's own declared maximum
+    /// applies either way.
+    pub matching_range: Option<f64>,
     /// The scans' frame (a bag's `header.frame_id`), when the input tells it: one more
     /// clue to recognise the range finder by.
     pub laser_frame: Option<String>,
@@ -77,6 +82,22 @@ impl Options {
     pub fn range_scale(&self, log: &odocal_log::Log) -> crate::RangeScale {
         let signature = crate::LaserSignature::of_log(log, self.laser_frame.as_deref());
         crate::RangeScale::resolve(self.laser_range_scale, signature.as_ref())
+    }
+
+    /// The scan matcher's settings for `log`: [`Options::icp`] with its readings
+    /// limited to [`Options::matching_range`] when stated, else to the range the log's
+    /// laser is rated for ([`crate::LaserSignature::matching_range`]).
+    pub fn icp_for(&self, log: &odocal_log::Log) -> IcpParams {
+        let range = self.matching_range.unwrap_or_else(|| {
+            crate::LaserSignature::of_log(log, self.laser_frame.as_deref())
+                .map_or(crate::range_finder::UNDECLARED_MATCHING_RANGE, |s| {
+                    s.matching_range()
+                })
+        });
+        IcpParams {
+            max_reading: self.icp.max_reading.min(range),
+            ..self.icp.clone()
+        }
     }
 
     /// The solver's settings with [`Options::accept_weak`] passed on.
@@ -107,6 +128,7 @@ impl Default for Options {
             accept_weak: false,
             odometry_only: false,
             laser_range_scale: None,
+            matching_range: None,
             laser_frame: None,
             lateral_slip: Default::default(),
         }

@@ -179,8 +179,9 @@ pub fn synchronize_and_match(
     let mut guess_params = opts.initial_params;
     let bootstrap = (opts.bootstrap_guesses || sweep) && kept.len() >= MIN_SAMPLES;
     // The log's typical range noise, estimated once for every match of its scans.
-    let log_noise = typical_noise_sigma(&log.scans, &opts.icp);
-    let log_icp = with_typical_noise(&opts.icp, log_noise);
+    let matcher = opts.icp_for(log);
+    let log_noise = typical_noise_sigma(&log.scans, &matcher);
+    let log_icp = with_typical_noise(&matcher, log_noise);
     if guess_params.is_none() && bootstrap {
         // Match a subset with identity guesses (an evenly spread one of long logs,
         // every pair of short ones), solve roughly, and guess the rest — and the
@@ -256,8 +257,8 @@ pub fn synchronize_and_match(
     let (noise, icp) = match &scans {
         Cow::Borrowed(_) => (log_noise, log_icp),
         Cow::Owned(store) => {
-            let noise = typical_noise_sigma(store, &opts.icp);
-            (noise, with_typical_noise(&opts.icp, noise))
+            let noise = typical_noise_sigma(store, &matcher);
+            (noise, with_typical_noise(&matcher, noise))
         }
     };
     let rest: Vec<usize> = (0..kept.len()).filter(|&i| matched[i].is_none()).collect();
@@ -365,7 +366,8 @@ fn second_pass(
     } else {
         (Cow::Borrowed(&log.scans), vec![true; index_pairs.len()])
     };
-    let icp = with_typical_noise(&opts.icp, typical_noise_sigma(&scans, &opts.icp));
+    let matcher = opts.icp_for(log);
+    let icp = with_typical_noise(&matcher, typical_noise_sigma(&scans, &matcher));
     progress.start("matching (second pass)", index_pairs.len());
     let mut matched: Vec<Result<MatchStats, MatchFailure>> =
         match_pairs(&scans, &index_pairs, &guesses, &icp, || progress.advance());

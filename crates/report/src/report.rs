@@ -178,6 +178,10 @@ pub struct Settings {
     pub first_guess: &'static str,
     /// Second matching pass.
     pub second_pass: bool,
+    /// Scan matching used the readings below this range (m): the range the laser is
+    /// rated for when recognised, else the maximum its scans declare (see
+    /// `odocal_pipeline::LaserSignature::matching_range`).
+    pub matching_range_m: f64,
     /// Clock offset applied when not estimated (s).
     pub time_offset_s: f64,
     /// Per parameter (r_L, r_R, b, l_x, l_y, l_theta): "free", {"held": value}
@@ -280,6 +284,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
                 "identity"
             },
             second_pass: opts.second_pass,
+            matching_range_m: opts.icp_for(log).max_reading,
             time_offset_s: opts.time_offset,
             constraints: opts.solve.constraints,
             accept_weak: opts.solve_options().accept_weak,
