@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{calibrate_json, odocal, stderr};
+use common::{calibrate_json, cleanup, odocal, simulated_log, stderr};
 use serde_json::Value;
 
 /// The bag of one drive seen by a front LDS (3.5 m) and a rear SICK-like laser (8 m).
@@ -26,6 +26,8 @@ fn each_laser_is_matched_to_its_rated_range() {
     let demo = calibrate_json(&["fixtures/demo.log"]);
     assert_eq!(demo["range_scale"]["sensor"], "Hokuyo URG-04LX");
     assert_eq!(matching_range(&demo), 4.0);
+    // It declares 4 m itself: nothing left out, nothing said.
+    assert!(demo["settings"]["matching_range_statement"].is_null());
     // The front LDS-01 to its 3.5 m, the rear SICK LMS2xx-like laser to its 8 m (its
     // sheet states an absolute accuracy over the whole range).
     let front = calibrate_json(&[TWO_LIDARS, "--scan-topic", "/scan_front"]);
@@ -53,6 +55,10 @@ fn far_readings_carry_information_and_a_stated_range_is_used() {
         "--accept-weak",
     ]);
     assert_eq!(matching_range(&short), 3.0);
+    assert_eq!(
+        short["settings"]["matching_range_statement"],
+        "readings up to 3 m of the 8 m the scans declare (as stated by --matching-range)"
+    );
     assert!(
         sigma_b(&short) > 1.5 * sigma_b(&full),
         "σ_b {} at 3 m vs {} at 8 m",
@@ -66,4 +72,23 @@ fn far_readings_carry_information_and_a_stated_range_is_used() {
         let err = stderr(&o);
         assert!(err.contains("positive number of metres"), "{bad}: {err}");
     }
+}
+
+#[test]
+fn readings_beyond_the_rated_range_are_said_to_be_left_out() {
+    // A simulated MinesRover-class URG-04LX reporting to 5.6 m: matched to 4 m, and the
+    // summary says so with the option to use more.
+    let (log, _) = simulated_log("matching-range-urg", "mines-rover", 30.0, 5, |_| {});
+    let path = log.to_str().unwrap();
+    let o = odocal(&["calibrate", path, "--accept-weak"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        out.contains(
+            "scan matching used readings up to 4 m of the 5.6 m the scans declare (the Hokuyo \
+             URG-04LX's rated range; --matching-range METRES to use more)"
+        ),
+        "{out}"
+    );
+    cleanup(&log);
 }

@@ -100,6 +100,41 @@ impl Options {
         }
     }
 
+    /// In words, when scan matching leaves out readings the scans of `log` declare
+    /// valid: "readings up to 4 m of the 5.6 m the scans declare (the Hokuyo
+    /// URG-04LX's rated range; …)"; `None` when it uses their whole range.
+    pub fn matching_range_statement(&self, log: &odocal_log::Log) -> Option<String> {
+        let signature = crate::LaserSignature::of_log(log, self.laser_frame.as_deref())?;
+        let used = self.icp_for(log).max_reading;
+        let declared = signature.max_range;
+        if used >= declared {
+            return None;
+        }
+        let why = match (self.matching_range, crate::recognise(&signature)) {
+            (Some(_), _) => "as stated by --matching-range".to_string(),
+            (None, Some(r)) => format!(
+                "the {}'s rated range; --matching-range METRES to use more",
+                r.finder.name
+            ),
+            (None, None) => {
+                "the scans declare no maximum range; --matching-range METRES states the laser's"
+                    .to_string()
+            }
+        };
+        let of = if declared.is_finite() {
+            format!(
+                " of the {} m the scans declare",
+                crate::range_finder::metres(declared)
+            )
+        } else {
+            String::new()
+        };
+        Some(format!(
+            "readings up to {} m{of} ({why})",
+            crate::range_finder::metres(used)
+        ))
+    }
+
     /// The solver's settings with [`Options::accept_weak`] passed on.
     pub fn solve_options(&self) -> SolveOptions {
         SolveOptions {

@@ -104,7 +104,7 @@ impl LaserSignature {
 
 /// A range in metres to the millimetre, without trailing zeros (a bag's `f32`
 /// 0.12 reads 0.11999999731779099 as `f64`).
-fn metres(x: f64) -> String {
+pub(crate) fn metres(x: f64) -> String {
     let s = format!("{x:.3}");
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }

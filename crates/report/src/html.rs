@@ -221,6 +221,9 @@ fn parameters(r: &Report, v: &Value) -> Markup {
             }
         }
         p.note #range-scale { "Laser range scale: " (r.range_scale.statement) "." }
+        @if let Some(m) = &r.settings.matching_range_statement {
+            p.note #matching-range { "Scan matching used " (m) "." }
+        }
         @if r.odometry_only {
             p.warning #odometry-only {
                 "Odometry-only mode: the input has odometry poses, no wheel encoders; the wheel rotations were recovered from the poses with the nominal r_L, r_R and b (--nominal). The absolute radii and wheel distance are only as good as those nominal values; the correction factors (estimate / nominal) are what the data determine."

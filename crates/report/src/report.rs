@@ -182,6 +182,10 @@ pub struct Settings {
     /// rated for when recognised, else the maximum its scans declare (see
     /// `odocal_pipeline::LaserSignature::matching_range`).
     pub matching_range_m: f64,
+    /// In words, when scan matching left out readings the scans declare valid ("readings
+    /// up to 4 m of the 5.6 m the scans declare (the Hokuyo URG-04LX's rated range; …)");
+    /// `None` when it used their whole range.
+    pub matching_range_statement: Option<String>,
     /// Clock offset applied when not estimated (s).
     pub time_offset_s: f64,
     /// Per parameter (r_L, r_R, b, l_x, l_y, l_theta): "free", {"held": value}
@@ -285,6 +289,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             },
             second_pass: opts.second_pass,
             matching_range_m: opts.icp_for(log).max_reading,
+            matching_range_statement: opts.matching_range_statement(log),
             time_offset_s: opts.time_offset,
             constraints: opts.solve.constraints,
             accept_weak: opts.solve_options().accept_weak,
@@ -476,6 +481,9 @@ impl fmt::Display for Report {
             writeln!(f, "  warning: {w}")?;
         }
         writeln!(f, "  laser range scale: {}", self.range_scale.statement)?;
+        if let Some(m) = &self.settings.matching_range_statement {
+            writeln!(f, "  scan matching used {m}")?;
+        }
         if let Some(t) = self.sweep_compensated_s {
             writeln!(
                 f,
