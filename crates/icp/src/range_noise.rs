@@ -12,9 +12,13 @@
 use crate::consistency::robust_spread;
 
 /// Fewest correspondences in one range bin (the spread of fewer is too noisy).
-const MIN_PER_BIN: usize = 40;
-/// Most range bins.
-const MAX_BINS: usize = 6;
+const MIN_PER_BIN: usize = 20;
+/// Most range bins. Enough that the far tail of a scan gets a bin of its own: on the
+/// simulated TurtleBot 4 (RPLIDAR to 12 m, σ = 3 mm + 0.5 %·r) the few far local lines
+/// (4–6 m) decide the directions along corridors, and bins of 40 or more (6 at most)
+/// mixed them with nearer points: 62 of 838 accepted pairs had an error beyond their
+/// covariance's 99.7 % level, 42 of 851 with bins of 20 or more (12 at most).
+const MAX_BINS: usize = 12;
 
 /// Scratch and result of [`RangeBins::variances`] (reused: no allocation per match
 /// once warmed up).
