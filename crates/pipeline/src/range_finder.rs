@@ -122,7 +122,7 @@ pub struct RangeFinder {
     pub data_sheet: &'static str,
     /// The range (m) up to which the data sheet states the accuracy; readings beyond
     /// it (a URG-04LX reports up to 5.6 m, rated to 4 m) are left out of scan
-    /// matching (see [`matching_range`]). ∞: the whole range the scans declare.
+    /// matching (see [`LaserSignature::matching_range`]). ∞: the whole range the scans declare.
     pub rated_range: f64,
     /// What identifies it in a log: the signature it must match.
     identifies: fn(&LaserSignature) -> bool,
