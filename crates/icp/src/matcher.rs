@@ -112,6 +112,16 @@ const DISTINCT_XY: f64 = 0.02;
 /// … or this (rad) are different alignments: the pair is ambiguous.
 const DISTINCT_THETA: f64 = 0.0175;
 
+/// The current point `q` placed in the reference frame by `estimate`, whose rotation's
+/// sine and cosine are `sc` (computed once per scan).
+#[inline]
+fn placed(estimate: &Pose2, (s, c): (f64, f64), q: [f64; 2]) -> [f64; 2] {
+    [
+        estimate.x + c * q[0] - s * q[1],
+        estimate.y + s * q[0] + c * q[1],
+    ]
+}
+
 /// Number of past correspondence sets remembered to detect a cycle.
 const CYCLE_MEMORY: usize = 8;
 
@@ -537,10 +547,7 @@ impl Matcher {
         self.squared_residuals.clear();
         self.range_bins.clear();
         let residual = |k: &Correspondence| {
-            let p = [
-                estimate.x + c * k.q[0] - s * k.q[1],
-                estimate.y + s * k.q[0] + c * k.q[1],
-            ];
+            let p = placed(&estimate, (s, c), k.q);
             k.normal[0] * p[0] + k.normal[1] * p[1] - k.offset
         };
         for k in &self.correspondences {
@@ -635,10 +642,7 @@ impl Matcher {
                 continue;
             }
             let q = current.points[i as usize];
-            let p = [
-                estimate.x + c * q[0] - s * q[1],
-                estimate.y + s * q[0] + c * q[1],
-            ];
+            let p = placed(estimate, (s, c), q);
             let nearest = self.nearest_reference(reference, p, k, gate2, use_tree);
             if nearest.is_none_or(|j| !reference.incidence_cos[j].is_nan()) {
                 count += 1;
@@ -677,10 +681,7 @@ impl Matcher {
         let (s, c) = estimate.theta.sin_cos();
         for (k, &i) in current.valid_indices.iter().enumerate() {
             let q = current.points[i as usize];
-            let p = [
-                estimate.x + c * q[0] - s * q[1],
-                estimate.y + s * q[0] + c * q[1],
-            ];
+            let p = placed(estimate, (s, c), q);
             let nearest = self.nearest_reference(reference, p, k, gate2, use_tree);
             let Some(j) = nearest else { continue };
             self.search_start[k] = j as u32;

@@ -88,16 +88,23 @@ impl Options {
     /// limited to [`Options::matching_range`] when stated, else to the range the log's
     /// laser is rated for ([`crate::LaserSignature::matching_range`]).
     pub fn icp_for(&self, log: &odocal_log::Log) -> IcpParams {
-        let range = self.matching_range.unwrap_or_else(|| {
-            crate::LaserSignature::of_log(log, self.laser_frame.as_deref())
-                .map_or(crate::range_finder::UNDECLARED_MATCHING_RANGE, |s| {
-                    s.matching_range()
-                })
-        });
+        let signature = crate::LaserSignature::of_log(log, self.laser_frame.as_deref());
         IcpParams {
-            max_reading: self.icp.max_reading.min(range),
+            max_reading: self.reading_limit(signature.as_ref()),
             ..self.icp.clone()
         }
+    }
+
+    /// The range (m) below which scan matching uses the readings of the laser of
+    /// `signature`: [`Options::matching_range`] when stated, else its rated range;
+    /// within [`Options::icp`]'s own `max_reading`.
+    fn reading_limit(&self, signature: Option<&crate::LaserSignature>) -> f64 {
+        let range = self.matching_range.unwrap_or_else(|| {
+            signature.map_or(crate::range_finder::UNDECLARED_MATCHING_RANGE, |s| {
+                s.matching_range()
+            })
+        });
+        self.icp.max_reading.min(range)
     }
 
     /// In words, when scan matching leaves out readings the scans of `log` declare
@@ -105,7 +112,7 @@ impl Options {
     /// URG-04LX's rated range; …)"; `None` when it uses their whole range.
     pub fn matching_range_statement(&self, log: &odocal_log::Log) -> Option<String> {
         let signature = crate::LaserSignature::of_log(log, self.laser_frame.as_deref())?;
-        let used = self.icp_for(log).max_reading;
+        let used = self.reading_limit(Some(&signature));
         let declared = signature.max_range;
         if used >= declared {
             return None;
