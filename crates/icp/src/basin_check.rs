@@ -61,15 +61,8 @@ fn moved(pose: &Pose2, weak: [f64; 3], step: f64, rho: f64) -> Pose2 {
 
 /// RMS range of the scan's valid points (m; 0 when none).
 pub(crate) fn rms_range(scan: &PreparedScan) -> f64 {
-    let n = scan.valid_indices.len().max(1) as f64;
-    let sum: f64 = scan
-        .valid_indices
-        .iter()
-        .map(|&i| {
-            let p = scan.points[i as usize];
-            p[0] * p[0] + p[1] * p[1]
-        })
-        .sum();
+    let n = scan.points.len().max(1) as f64;
+    let sum: f64 = scan.points.iter().map(|p| p[0] * p[0] + p[1] * p[1]).sum();
     (sum / n).sqrt()
 }
 

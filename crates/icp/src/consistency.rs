@@ -16,7 +16,7 @@ const MAD_TO_SIGMA: f64 = 1.482_602_218_505_602;
 /// Noise floor relative to the largest range: exact (noise-free) scans still carry
 /// the rounding of ranges stored as `f32` and of the local-line fits, and a right
 /// match of them leaves residuals of that size.
-const EXACT_NOISE_SHARE: f64 = 1e-5;
+pub(crate) const EXACT_NOISE_SHARE: f64 = 1e-5;
 
 /// `1.4826 · √median` of the squared weighted residuals (reordered; 0 when empty).
 pub(crate) fn robust_spread(squared_residuals: &mut [f64]) -> f64 {

@@ -70,7 +70,6 @@ pub(crate) fn nearest_by_angle(
     if first_ccw >= 2 && first_ccw + 2 < n {
         for (k, ray) in rays.iter().enumerate().skip(first_ccw - 2).take(4) {
             let d2 = dist2(ray.point, p);
-            // NaN (invalid point) never compares smaller.
             if d2 < best {
                 best = d2;
                 best_k = k;
@@ -118,7 +117,7 @@ pub(crate) fn nearest_by_tree(
 ) -> Option<usize> {
     let tree = reference.tree.as_ref()?;
     let found = tree.nearest_one::<SquaredEuclidean>(&p);
-    (found.distance < max_dist2).then(|| reference.valid_indices[found.item as usize] as usize)
+    (found.distance < max_dist2).then_some(found.item as usize)
 }
 
 /// The reference segment `p` lies on, given its closest reference point `j`.
@@ -136,24 +135,13 @@ pub(crate) fn segment_for(reference: &PreparedScan, p: [f64; 2], j: usize) -> Op
         Some(j)
     } else if backward >= 0.0 {
         Some(j - 1)
-    } else if forward.is_nan() && backward < 0.0 && no_return_after(reference, j) {
+    } else if forward.is_nan() && backward < 0.0 && reference.no_return_after(j) {
         within_extension(reference, j, j - 1, -backward).then(|| j - 1)
-    } else if backward.is_nan() && forward < 0.0 && no_return_before(reference, j) {
+    } else if backward.is_nan() && forward < 0.0 && reference.no_return_before(j) {
         within_extension(reference, j, j + 1, -forward).then_some(j)
     } else {
         None
     }
-}
-
-/// Run ends where the surface may go on unseen: the next ray got no return.
-fn no_return_after(reference: &PreparedScan, j: usize) -> bool {
-    reference.no_return.get(j + 1).copied().unwrap_or(false)
-}
-
-/// … or the previous ray got no return (a reading beyond the maximum range is a far
-/// surface: the run's surface ended there).
-fn no_return_before(reference: &PreparedScan, j: usize) -> bool {
-    j > 0 && reference.no_return[j - 1]
 }
 
 /// Beyond the end `j` of a run whose last segment goes to `inner`, a point projecting
@@ -200,14 +188,19 @@ mod tests {
         PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).expect("scan")
     }
 
-    /// The point on the wall at x, and the closest reference point to it.
+    /// The point on the wall at x, and the closest reference point to it (its index
+    /// among the scan's valid points).
     fn on_wall(scan: &PreparedScan, x: f64) -> ([f64; 2], usize) {
         let p = [x, 2.0];
-        let j = (0..scan.len())
-            .filter(|&i| scan.valid[i])
+        let j = (0..scan.points.len())
             .min_by(|&a, &b| dist2(scan.points[a], p).total_cmp(&dist2(scan.points[b], p)))
             .expect("a valid point");
         (p, j)
+    }
+
+    /// The scan's reading (ray) of valid point or segment `k`.
+    fn ray(scan: &PreparedScan, k: Option<usize>) -> Option<u32> {
+        k.map(|k| scan.original[k])
     }
 
     #[test]
@@ -215,25 +208,25 @@ mod tests {
         // Rays 90..100 (x from 0 to −0.17 m) got no return; the run before them ends
         // at ray 89 (x ≈ 0.017 m), with segments ≈ 17 mm long.
         let scan = wall_with_gap(90..100, None);
-        let (end, end_ray) = on_wall(&scan, 0.0175);
-        assert_eq!(end_ray, 89, "{end:?}");
+        let (end, end_point) = on_wall(&scan, 0.0175);
+        assert_eq!(scan.original[end_point], 89, "{end:?}");
         // One and a half segment lengths past the end: measured against the end
         // segment's line (before: no correspondence).
         let (p, j) = on_wall(&scan, -0.008);
-        assert_eq!(j, 89);
-        assert_eq!(segment_for(&scan, p, j), Some(88));
+        assert_eq!(scan.original[j], 89);
+        assert_eq!(ray(&scan, segment_for(&scan, p, j)), Some(88));
         // Likewise past the start of the run after the gap (ray 100).
         let (p, j) = on_wall(&scan, -0.16);
-        assert_eq!(j, 100);
-        assert_eq!(segment_for(&scan, p, j), Some(100));
+        assert_eq!(scan.original[j], 100);
+        assert_eq!(ray(&scan, segment_for(&scan, p, j)), Some(100));
         // Far past the end (5 segment lengths): unseen, no correspondence.
         let (p, j) = on_wall(&scan, -0.07);
         assert_eq!(segment_for(&scan, p, j), None, "ray {j}");
     }
 
     #[test]
-    fn a_run_ending_at_a_rare_dropout_is_not_followed() {
-        // The same gap in a scan that has no other missing reading: a dropout.
+    fn a_rare_dropout_is_bridged_and_a_run_ending_at_one_is_not_followed() {
+        // One missing reading (ray 90) in a scan that has no other: a dropout.
         let angles: Vec<f64> = (0..181)
             .map(|i| (45.0 + i as f64 * 0.5).to_radians())
             .collect();
@@ -242,10 +235,21 @@ mod tests {
             .enumerate()
             .map(|(i, a)| if i == 90 { 0.0 } else { (2.0 / a.sin()) as f32 })
             .collect();
+        // Bridged: the point where ray 90 would have hit is on the segment 89 → 91.
         let scan =
             PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).expect("scan");
         let (p, j) = on_wall(&scan, 0.008);
-        assert_eq!(j, 89);
+        assert_eq!(scan.original[j], 89);
+        assert_eq!(ray(&scan, segment_for(&scan, p, j)), Some(89));
+        assert_eq!(scan.original[segment_for(&scan, p, j).unwrap() + 1], 91);
+        // Not bridged: the run ends at ray 89 and is not followed past it.
+        let params = IcpParams {
+            bridged_missing_rays: 0,
+            ..IcpParams::default()
+        };
+        let scan = PreparedScan::new(&ranges, &angles, 0.02, 5.6, &params).expect("scan");
+        let (p, j) = on_wall(&scan, 0.008);
+        assert_eq!(scan.original[j], 89);
         assert_eq!(segment_for(&scan, p, j), None);
     }
 
@@ -257,7 +261,7 @@ mod tests {
         for far in [3.5, 6.0] {
             let scan = wall_with_gap(90..100, Some(far));
             let (p, j) = on_wall(&scan, -0.008);
-            assert_eq!(j, 89, "{far}");
+            assert_eq!(scan.original[j], 89, "{far}");
             assert_eq!(segment_for(&scan, p, j), None, "{far}");
         }
     }

@@ -2,11 +2,14 @@
 //! two scans, with its covariance.
 //!
 //! The pipeline, one small step per module:
-//! 1. [`PreparedScan::new`] (module `preprocess`): ranges → points, validity, runs
-//!    without range discontinuities, and for every segment between consecutive
-//!    points a *local line* (total least squares over the best-fitting window of
-//!    `line_fit_window` run points containing it). Done once per scan, reused as
-//!    reference or current scan.
+//! 1. [`PreparedScan::new`] (module `preprocess`): the valid readings → points, runs
+//!    without range discontinuities (across up to
+//!    [`IcpParams::bridged_missing_rays`] readings without a return), and for every
+//!    segment between consecutive points a *local line* (total least squares over
+//!    the best-fitting window of `line_fit_window` run points containing it); the
+//!    scan's range noise from those windows, or from lines through metric
+//!    neighbourhoods when it has too few. Done once per scan, reused as reference or
+//!    current scan.
 //! 2. `correspondence`: each current point ↔ the segment between its two closest
 //!    consecutive reference points (closest point by CSM's angular walk over the
 //!    ordered rays — the default — or a kiddo k-d tree; no segment across a range

@@ -281,7 +281,7 @@ impl Matcher {
                 .iter()
                 .map(|c| (c.q, c.normal, c.offset, c.weight)),
         );
-        let unmatched = current.valid_indices.len() - self.correspondences.len();
+        let unmatched = current.points.len() - self.correspondences.len();
         self.correspondences
             .iter()
             .map(|k| k.normalized_sq.min(tau_sq))
@@ -302,7 +302,7 @@ impl Matcher {
         tau_sq: f64,
         use_tree: bool,
     ) -> (f64, f64) {
-        let n = current.valid_indices.len() as f64;
+        let n = current.points.len() as f64;
         let (s, c) = pose.theta.sin_cos();
         let fixed: f64 = self
             .fixed_lines
@@ -342,23 +342,20 @@ impl Matcher {
         // by the guessed rotation (the walk then corrects for the translation).
         self.weight_cache.clear();
         self.weight_cache
-            .resize(current.valid_indices.len(), (u32::MAX, 0.0));
+            .resize(current.points.len(), (u32::MAX, 0.0));
         self.search_start.clear();
         match (reference.uniform, current.uniform) {
             // Same ray geometry: the guess is a shift of the ray index.
             (Some(r), Some(c)) if r == c => {
                 let shift = (start.theta / r.1).round();
-                let last = reference.len() as f64 - 1.0;
+                let last = reference.points.len() as f64 - 1.0;
                 self.search_start.extend(
-                    current
-                        .valid_indices
-                        .iter()
-                        .map(|&i| (i as f64 + shift).clamp(0.0, last) as u32),
+                    (0..current.points.len()).map(|i| (i as f64 + shift).clamp(0.0, last) as u32),
                 );
             }
             _ => {
-                for &i in &current.valid_indices {
-                    let bearing = current.angles[i as usize] + start.theta;
+                for angle in &current.angles {
+                    let bearing = angle + start.theta;
                     self.search_start
                         .push(reference.ray_near_bearing(bearing) as u32);
                 }
@@ -563,7 +560,7 @@ impl Matcher {
             let e = residual(k);
             sum_abs += e.abs();
             info.add(
-                current.valid_indices[(k.key >> 32) as usize] as usize,
+                current.original[(k.key >> 32) as usize] as usize,
                 k.q,
                 k.normal,
                 e,
@@ -637,11 +634,10 @@ impl Matcher {
     ) -> usize {
         let (s, c) = estimate.theta.sin_cos();
         let mut count = 0;
-        for (k, &i) in current.valid_indices.iter().enumerate() {
-            if current.incidence_cos[i as usize].is_nan() {
+        for (k, &q) in current.points.iter().enumerate() {
+            if current.incidence_cos[k].is_nan() {
                 continue;
             }
-            let q = current.points[i as usize];
             let p = placed(estimate, (s, c), q);
             let nearest = self.nearest_reference(reference, p, k, gate2, use_tree);
             if nearest.is_none_or(|j| !reference.incidence_cos[j].is_nan()) {
@@ -679,8 +675,7 @@ impl Matcher {
     ) {
         self.correspondences.clear();
         let (s, c) = estimate.theta.sin_cos();
-        for (k, &i) in current.valid_indices.iter().enumerate() {
-            let q = current.points[i as usize];
+        for (k, &q) in current.points.iter().enumerate() {
             let p = placed(estimate, (s, c), q);
             let nearest = self.nearest_reference(reference, p, k, gate2, use_tree);
             let Some(j) = nearest else { continue };
@@ -700,7 +695,7 @@ impl Matcher {
                 // Incidence of the current ray on its own surface (a property of the
                 // current scan alone, so that a correspondence's weight never depends
                 // on the estimate), or of the reference rays when unknown.
-                let own = current.incidence_cos[i as usize];
+                let own = current.incidence_cos[k];
                 let cos_cur = if own.is_nan() {
                     line.incidence_cos
                 } else {

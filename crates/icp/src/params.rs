@@ -65,6 +65,13 @@ pub struct IcpParams {
     pub discontinuity_min_gap: f64,
     /// … see [`IcpParams::discontinuity_min_gap`].
     pub discontinuity_gap_factor: f64,
+    /// Two valid points with up to this many readings without a return between them
+    /// (zero, NaN or at most the minimum range: dropouts, dark or glancing spots) are
+    /// consecutive points of one run, on one surface when the gap test above holds
+    /// over their angle; 0: only neighbouring rays are. Readings at or beyond the
+    /// maximum range (+∞ included) are never bridged: the surface ended there. 2 by
+    /// default (docs/benchmarks.md, "Runs across missing readings").
+    pub bridged_missing_rays: usize,
     /// A scan with fewer valid readings is rejected.
     pub min_valid_points: usize,
     /// A match with fewer used correspondences is rejected.
@@ -151,6 +158,7 @@ impl Default for IcpParams {
             max_line_fit_rms: 0.01,
             discontinuity_min_gap: 0.05,
             discontinuity_gap_factor: 10.0,
+            bridged_missing_rays: 2,
             min_valid_points: 20,
             min_correspondences: 20,
             max_condition_number: 50.0,

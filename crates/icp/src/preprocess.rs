@@ -1,14 +1,17 @@
 //! A scan made ready for matching, once, whatever role it plays later.
 //!
-//! Preparation turns ranges into Cartesian points, marks the invalid readings
-//! (0, non-finite, out of range), cuts the scan into runs of consecutive points on
-//! one surface (no run crosses a range discontinuity), and gives every segment
+//! Preparation keeps the valid readings (not 0, finite, within range) as Cartesian
+//! points, cuts them into runs of consecutive points on one surface (no run crosses
+//! a range discontinuity or a far reading; it goes across up to
+//! `bridged_missing_rays` readings without a return), and gives every segment
 //! between two consecutive points of a run a *local line*: the total-least-squares
 //! line of the window of `line_fit_window` consecutive run points containing both
 //! ends that fits best. Matching measures point-to-line distances to these lines
 //! rather than to the raw segment, whose direction two noisy points barely fix.
 //! On noise-free straight walls the local line is the wall itself.
 
+use crate::consistency::EXACT_NOISE_SHARE;
+use crate::neighbourhood_lines::NeighbourhoodLines;
 use crate::{IcpError, IcpParams, NeighbourSearch};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 
@@ -29,16 +32,16 @@ pub(crate) struct SegmentLine {
 }
 
 /// The k-d tree over a scan's valid points (leaf size 32; items are indices into
-/// [`PreparedScan::valid_indices`]).
+/// [`PreparedScan::points`]).
 pub(crate) type PointTree = ImmutableKdTree<f64, u32, 2, 32>;
 
-/// One ray: its unit direction and its point (NaN when the reading is invalid), kept
+/// One ray with a valid reading: its unit direction and its point, kept
 /// together so that the closest-point search reads one cache line per ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Ray {
     /// Unit direction `(cos, sin)` in the sensor frame.
     pub dir: [f64; 2],
-    /// The measured point in the sensor frame, NaN when invalid.
+    /// The measured point in the sensor frame.
     pub point: [f64; 2],
 }
 
@@ -53,28 +56,34 @@ pub(crate) struct Sides {
 }
 
 /// A scan preprocessed once, usable as reference or as current scan any number of times.
+///
+/// Its valid readings only are kept, in ray order (the arrays below are indexed by
+/// them); `original` says which reading of the scan each one is.
 #[derive(Debug, Clone)]
 pub struct PreparedScan {
-    /// Ray angles (rad).
+    /// Number of readings of the scan, valid or not.
+    pub(crate) ray_count: usize,
+    /// Angle between neighbouring rays of the scan (rad; the mean over its span when
+    /// they are not uniformly spaced).
+    pub(crate) ray_step: f64,
+    /// `original[k]`: the reading of the scan that kept point `k` is.
+    pub(crate) original: Vec<u32>,
+    /// Ray angles of the kept readings (rad).
     pub(crate) angles: Vec<f64>,
     /// Ray directions and points.
     pub(crate) rays: Vec<Ray>,
     /// Directions to the neighbours along usable segments.
     pub(crate) sides: Vec<Sides>,
-    /// Points in the sensor frame (NaN where invalid).
+    /// The valid readings' points in the sensor frame.
     pub(crate) points: Vec<[f64; 2]>,
-    /// Validity of each reading.
-    pub(crate) valid: Vec<bool>,
     /// |cos| of the incidence angle of each ray on its own surface (mean over the
     /// usable segments at the point), NaN when the point has no usable segment.
     pub(crate) incidence_cos: Vec<f64>,
-    /// Readings without a return (zero, non-finite or below the minimum range: dark,
-    /// glancing or transparent surfaces), as opposed to valid ones and to readings
-    /// beyond the maximum range (a far surface was seen); all false in a scan where
-    /// they are rare (see `no_returns`).
+    /// Per reading of the scan (not only the kept ones): without a return (zero,
+    /// non-finite or below the minimum range: dark, glancing or transparent surfaces),
+    /// as opposed to valid ones and to readings beyond the maximum range (a far
+    /// surface was seen); all false in a scan where they are rare (see `no_returns`).
     pub(crate) no_return: Vec<bool>,
-    /// Indices of the valid readings, increasing.
-    pub(crate) valid_indices: Vec<u32>,
     /// Valid readings on a usable local line (finite `incidence_cos`): the points a
     /// right match can be expected to explain.
     pub(crate) lined_count: usize,
@@ -90,8 +99,10 @@ pub struct PreparedScan {
     /// variance of its line's tilt (rad²), estimated from the scan itself.
     pub(crate) tilt_noise_scale: f64,
     /// Range-noise standard deviation (m) the scan shows itself: the scatter of its
-    /// points about their local lines (`None` when it has fewer than 10 usable
-    /// windows: unknown, which is not the same as noise-free).
+    /// points about their local lines; when it has fewer than 10 usable windows
+    /// (most readings missing), about lines through metric neighbourhoods
+    /// (`neighbourhood_lines`); `None` when those are fewer than 10 too: unknown,
+    /// which is not the same as noise-free.
     pub(crate) noise_sigma: Option<f64>,
     /// k-d tree over the valid points, built when the k-d search is asked for or the
     /// angles do not allow the angular search.
@@ -146,42 +157,45 @@ impl PreparedScan {
                 "min_range and max_range must not be NaN".to_string(),
             ));
         }
-        let n = ranges.len();
+        let ray_count = ranges.len();
         let lo = min_range.max(params.min_reading);
         let hi = max_range.min(params.max_reading);
+        let ray_step = mean_step(angles);
+        let no_return = no_returns(ranges, lo);
+        let (original, bridgeable) = kept_readings(ranges, lo, hi, params.bridged_missing_rays);
+        let ranges: Vec<f32> = original.iter().map(|&i| ranges[i as usize]).collect();
+        let angles: Vec<f64> = original.iter().map(|&i| angles[i as usize]).collect();
+        let (ranges, angles) = (&ranges[..], &angles[..]);
+        let n = ranges.len();
 
-        let mut points = Vec::with_capacity(n);
-        let mut valid = Vec::with_capacity(n);
-        let mut inv_ranges = Vec::with_capacity(n);
-        let mut valid_indices = Vec::with_capacity(n);
-        let mut max_valid_range: f64 = 0.0;
         let uniform = uniform_spacing(angles);
         let dirs = ray_directions(angles, uniform);
-        for (i, (&r, &[c, s])) in ranges.iter().zip(&dirs).enumerate() {
-            let r = f64::from(r);
-            let ok = r.is_finite() && r != 0.0 && r > lo && r < hi;
-            valid.push(ok);
-            inv_ranges.push(if ok { 1.0 / r } else { 0.0 });
-            if ok {
-                points.push([r * c, r * s]);
-                valid_indices.push(i as u32);
-                max_valid_range = max_valid_range.max(r);
-            } else {
-                points.push([f64::NAN, f64::NAN]);
-            }
-        }
-        if valid_indices.len() < params.min_valid_points {
+        let points: Vec<[f64; 2]> = ranges
+            .iter()
+            .zip(&dirs)
+            .map(|(&r, &[c, s])| [f64::from(r) * c, f64::from(r) * s])
+            .collect();
+        let inv_ranges: Vec<f64> = ranges.iter().map(|&r| 1.0 / f64::from(r)).collect();
+        let max_valid_range = ranges.iter().fold(0.0, |m: f64, &r| m.max(f64::from(r)));
+        if n < params.min_valid_points {
             return Err(IcpError::TooFewValidPoints {
-                valid: valid_indices.len(),
-                total: n,
+                valid: n,
+                total: ray_count,
                 needed: params.min_valid_points,
             });
         }
 
         let angles_increasing = angles.windows(2).all(|w| w[1] > w[0]);
-        let connected = connections(ranges, angles, &points, &valid, params);
+        let connected = connections(ranges, angles, &points, &bridgeable, params);
         let (segments, tilt_noise_scale, noise_sigma) =
             local_lines(&points, &inv_ranges, &connected, params);
+        // Too few straight runs of consecutive points (most readings missing): the
+        // scatter about lines through metric neighbourhoods, whichever rays they are.
+        let noise_sigma = noise_sigma.or_else(|| {
+            let lines = NeighbourhoodLines::new(&points, EXACT_NOISE_SHARE * max_valid_range);
+            let usable = lines.lines.iter().flatten().count();
+            lines.noise_sigma.filter(|_| usable >= MIN_NOISE_LINES)
+        });
         let incidence_cos = (0..n)
             .map(|i| {
                 let before = i.checked_sub(1).and_then(|k| segments[k]);
@@ -226,20 +240,20 @@ impl PreparedScan {
             .map(|(&dir, &point)| Ray { dir, point })
             .collect();
         let tree = if params.search == NeighbourSearch::KdTree || !angles_increasing {
-            let pts: Vec<[f64; 2]> = valid_indices.iter().map(|&i| points[i as usize]).collect();
-            Some(PointTree::new_from_slice(&pts))
+            Some(PointTree::new_from_slice(&points))
         } else {
             None
         };
         Ok(PreparedScan {
+            ray_count,
+            ray_step,
+            original,
             angles: angles.to_vec(),
             rays,
             sides,
             points,
-            valid,
-            no_return: no_returns(ranges, lo),
+            no_return,
             incidence_cos,
-            valid_indices,
             lined_count,
             segments,
             angles_increasing,
@@ -259,17 +273,17 @@ impl PreparedScan {
 
     /// Number of readings (valid or not).
     pub fn len(&self) -> usize {
-        self.points.len()
+        self.ray_count
     }
 
     /// True when the scan has no readings (never, for a successfully prepared scan).
     pub fn is_empty(&self) -> bool {
-        self.points.is_empty()
+        self.ray_count == 0
     }
 
     /// Number of valid readings.
     pub fn valid_count(&self) -> usize {
-        self.valid_indices.len()
+        self.points.len()
     }
 
     /// Number of segments with a usable local line.
@@ -277,9 +291,25 @@ impl PreparedScan {
         self.segments.iter().filter(|s| s.is_some()).count()
     }
 
-    /// Point `i` in the sensor frame, `None` when the reading is invalid.
+    /// Point `i` (the scan's reading `i`) in the sensor frame, `None` when the reading
+    /// is invalid.
     pub fn point(&self, i: usize) -> Option<[f64; 2]> {
-        (*self.valid.get(i)?).then(|| self.points[i])
+        let k = self.original.binary_search(&u32::try_from(i).ok()?).ok()?;
+        Some(self.points[k])
+    }
+
+    /// Run ends where the surface may go on unseen: the reading after kept point `k`
+    /// got no return.
+    pub(crate) fn no_return_after(&self, k: usize) -> bool {
+        let i = self.original[k] as usize;
+        self.no_return.get(i + 1).copied().unwrap_or(false)
+    }
+
+    /// … or the reading before it got no return (a reading beyond the maximum range
+    /// is a far surface: the run's surface ended there).
+    pub(crate) fn no_return_before(&self, k: usize) -> bool {
+        let i = self.original[k] as usize;
+        i > 0 && self.no_return[i - 1]
     }
 
     /// Index of the ray whose angle is closest to `bearing` (rad, not wrapped).
@@ -317,6 +347,48 @@ fn no_returns(ranges: &[f32], lo: f64) -> Vec<bool> {
 
 /// See [`no_returns`].
 const SPARSE_SCAN_SHARE: f64 = 0.45;
+
+/// Fewest usable lines that show a scan's noise (windows or metric neighbourhoods).
+const MIN_NOISE_LINES: usize = 10;
+
+/// The readings a scan keeps, valid ones (finite, above `lo` and 0, below `hi`, m), in
+/// ray order; and per kept reading, whether it and the next kept one may be
+/// consecutive points of a run: neighbouring rays, or at most `bridged` readings
+/// between them, all without a return (zero, NaN or at most `lo`: dropouts). A
+/// reading at or beyond `hi` between them (a far surface, or none in range) is never
+/// bridged.
+fn kept_readings(ranges: &[f32], lo: f64, hi: f64, bridged: usize) -> (Vec<u32>, Vec<bool>) {
+    let mut kept = Vec::with_capacity(ranges.len());
+    let mut bridgeable = Vec::with_capacity(ranges.len());
+    // Missing readings since the last kept one; `None` once a far one broke the run.
+    let mut missing_since: Option<usize> = Some(0);
+    for (i, &r) in ranges.iter().enumerate() {
+        let r = f64::from(r);
+        if r.is_finite() && r > lo.max(0.0) && r < hi {
+            if !kept.is_empty() {
+                bridgeable.push(missing_since.is_some_and(|m| m <= bridged));
+            }
+            kept.push(i as u32);
+            missing_since = Some(0);
+        } else if r.is_nan() || r <= lo.max(0.0) {
+            missing_since = missing_since.map(|m| m + 1);
+        } else {
+            missing_since = None;
+        }
+    }
+    if !kept.is_empty() {
+        bridgeable.push(false);
+    }
+    (kept, bridgeable)
+}
+
+/// Mean angle between neighbouring rays (rad; 0 for fewer than two).
+fn mean_step(angles: &[f64]) -> f64 {
+    match (angles.first(), angles.last()) {
+        (Some(a), Some(b)) if angles.len() > 1 => (b - a).abs() / (angles.len() - 1) as f64,
+        _ => 0.0,
+    }
+}
 
 /// Unit directions of the rays. For uniformly spaced angles (every laser) they are
 /// generated by rotating with the step, re-anchored on an exact `sin_cos` every 32
@@ -364,18 +436,19 @@ fn uniform_spacing(angles: &[f64]) -> Option<(f64, f64)> {
     uniform.then_some((angles[0], step))
 }
 
-/// `connected[i]`: points `i` and `i + 1` are valid and on one surface (no range jump).
+/// `connected[i]`: kept points `i` and `i + 1` are consecutive points of a run
+/// (`bridgeable[i]`) and on one surface (no range jump over the angle between them).
 fn connections(
     ranges: &[f32],
     angles: &[f64],
     points: &[[f64; 2]],
-    valid: &[bool],
+    bridgeable: &[bool],
     params: &IcpParams,
 ) -> Vec<bool> {
     let n = points.len();
     let mut connected = vec![false; n];
     for i in 0..n.saturating_sub(1) {
-        if !(valid[i] && valid[i + 1]) {
+        if !bridgeable[i] {
             continue;
         }
         let r = f64::from(ranges[i].max(ranges[i + 1]));
@@ -535,7 +608,7 @@ const MIN_NOISE_COS2: f64 = 0.04;
 /// whole, so that on such sensors it is below the per-ray σ (≈ 0.6 σ for the
 /// simulated URG-04LX). `None` (unknown) when fewer than 10 windows.
 fn noise_scale(variances: &mut [f64]) -> Option<f64> {
-    if variances.len() < 10 {
+    if variances.len() < MIN_NOISE_LINES {
         return None;
     }
     let mid = variances.len() / 2;
@@ -684,13 +757,46 @@ mod tests {
         for i in 3..8 {
             assert!(scan.point(i).is_none(), "reading {i} must be invalid");
         }
-        // Segments touching invalid readings are unusable; the wall x = 1 elsewhere.
-        assert!(scan.segments[2].is_none() && scan.segments[7].is_none());
+        // Only the valid readings are kept; no segment crosses the far readings (5:
+        // infinite, 6: beyond the maximum range) between rays 2 and 8.
+        let kept: Vec<u32> = scan.original.iter().take(4).copied().collect();
+        assert_eq!(kept, [0, 1, 2, 8]);
+        assert!(scan.segments[2].is_none());
+        // The wall x = 1 elsewhere.
         let line = scan.segments[20].expect("segment on the wall");
         assert!(
             (line.normal[0] + 1.0).abs() < 1e-9 && (line.offset + 1.0).abs() < 1e-6,
             "{line:?}"
         );
+    }
+
+    #[test]
+    fn dropouts_are_bridged_up_to_the_limit() {
+        // A wall at x = 1; two readings missing after ray 9, three after ray 19.
+        let angles: Vec<f64> = (0..40).map(|i| -0.5 + 0.025 * i as f64).collect();
+        let mut ranges: Vec<f32> = angles.iter().map(|a| (1.0 / a.cos()) as f32).collect();
+        for i in [10, 11, 20, 21, 22] {
+            ranges[i] = 0.0;
+        }
+        let segment_from = |scan: &PreparedScan, ray: u32| {
+            let k = scan.original.binary_search(&ray).expect("a kept reading");
+            (scan.original[k + 1], scan.segments[k])
+        };
+        let scan = PreparedScan::new(&ranges, &angles, 0.02, 4.0, &IcpParams::default())
+            .expect("enough valid points");
+        let (next, line) = segment_from(&scan, 9);
+        assert_eq!(next, 12);
+        let line = line.expect("two dropouts bridged");
+        assert!((line.normal[0] + 1.0).abs() < 1e-9 && (line.offset + 1.0).abs() < 1e-6);
+        assert_eq!(segment_from(&scan, 19), (23, None), "three are not");
+        // Not bridging: the run ends at either gap.
+        let params = IcpParams {
+            bridged_missing_rays: 0,
+            ..IcpParams::default()
+        };
+        let scan = PreparedScan::new(&ranges, &angles, 0.02, 4.0, &params).expect("valid points");
+        assert_eq!(segment_from(&scan, 9), (12, None));
+        assert!(scan.point(10).is_none() && scan.point(12).is_some());
     }
 
     #[test]

@@ -108,33 +108,21 @@ pub(crate) fn applies(
     params: &IcpParams,
 ) -> bool {
     let limit = params.sparse_below_returns as f64;
-    let sparse = |s: &PreparedScan| ray_step(s) >= COARSE_RAY_STEP && returns_per_turn(s) < limit;
+    let sparse = |s: &PreparedScan| s.ray_step >= COARSE_RAY_STEP && returns_per_turn(s) < limit;
     sparse(reference) || sparse(current)
 }
 
 /// The valid readings of `scan` per full turn of its field of view: a 240° laser with
 /// 136 returns has 204 per turn, a 360° one with 80 returns 80.
 fn returns_per_turn(scan: &PreparedScan) -> f64 {
-    let span = (ray_step(scan) * scan.angles.len() as f64).clamp(1e-3, std::f64::consts::TAU);
+    let span = (scan.ray_step * scan.ray_count as f64).clamp(1e-3, std::f64::consts::TAU);
     scan.valid_count() as f64 * std::f64::consts::TAU / span
 }
 
 /// The valid points of a scan and their ray indices.
 fn valid_points(scan: &PreparedScan) -> (Vec<[f64; 2]>, Vec<usize>) {
-    let rays: Vec<usize> = scan.valid_indices.iter().map(|&i| i as usize).collect();
-    (rays.iter().map(|&i| scan.points[i]).collect(), rays)
-}
-
-/// The angle between neighbouring rays (rad).
-fn ray_step(scan: &PreparedScan) -> f64 {
-    match scan.uniform {
-        Some((_, step)) => step.abs(),
-        None => {
-            let n = scan.angles.len().max(2) as f64;
-            let span = scan.angles.last().unwrap_or(&0.0) - scan.angles.first().unwrap_or(&0.0);
-            span.abs() / (n - 1.0)
-        }
-    }
+    let rays = scan.original.iter().map(|&i| i as usize).collect();
+    (scan.points.clone(), rays)
 }
 
 /// One correspondence of the iterations.
