@@ -76,22 +76,21 @@ fn most_pairs_of_the_real_mines_logs_match_and_every_refusal_has_its_reason() {
 /// runs went across missing readings, no run of seven consecutive returns was left to
 /// show the scans' noise, the noise was taken as none, and every one of exp1's 181
 /// pairs was refused as a wrong alignment ("residuals"): no calibration. Now the
-/// calibration is the full log's, within the thinned log's σ.
+/// calibration is the full log's, within the thinned log's σ (this draw: 158 samples
+/// used against 155, ℓy −1.82σ, the others within 0.6σ; another draw gave b +1.42σ,
+/// ℓx +1.37σ).
 #[test]
 fn a_real_log_with_half_its_returns_dropped_calibrates_like_the_full_one() {
     let Some(path) = mines_log("exp1.log") else {
         return;
     };
     let full = odocal_log::read_log(&path, &Default::default()).unwrap();
+    use rand::{Rng, SeedableRng};
     let mut thinned = full.clone();
-    // xorshift64: deterministic, no dependency.
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
     let (mut kept, mut dropped) = (0usize, 0usize);
     for r in thinned.scans.ranges.iter_mut().filter(|r| **r > 0.0) {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        if state >> 63 == 1 {
+        if rng.random_bool(0.5) {
             *r = 0.0;
             dropped += 1;
         } else {
