@@ -7,8 +7,16 @@ mod support;
 use odocal_bag::{read_bag, BagFormat, BagOptions};
 use support::fixture;
 
+/// Held by the tests that read the file-compressed bag: its decompressed copy is a
+/// temporary file named after the process, which the removal test would otherwise
+/// see from the other test's read, running at the same time in another thread.
+static FILE_COMPRESSED_READS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 #[test]
 fn both_zstd_modes_read_to_the_same_log() {
+    let _one_at_a_time = FILE_COMPRESSED_READS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
     let file = read_bag(&fixture("khepera_db3_zstd_file"), &BagOptions::default()).unwrap();
     let message = read_bag(
         &fixture("khepera_mcap_zstd_message"),
@@ -34,6 +42,9 @@ fn both_zstd_modes_read_to_the_same_log() {
 
 #[test]
 fn the_decompressed_copy_of_a_file_compressed_bag_is_removed() {
+    let _one_at_a_time = FILE_COMPRESSED_READS
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
     let before = odocal_temp_files();
     read_bag(&fixture("khepera_db3_zstd_file"), &BagOptions::default()).unwrap();
     let after = odocal_temp_files();
