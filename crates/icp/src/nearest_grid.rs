@@ -94,13 +94,31 @@ impl NearestGrid {
     /// the radius (plus half a cell's diagonal) of that centre.
     #[inline]
     pub fn nearest(&self, p: [f64; 2]) -> Option<usize> {
-        let x = (p[0] - self.origin[0]) / self.cell;
-        let y = (p[1] - self.origin[1]) / self.cell;
-        // Also false for NaN.
-        if !(x >= 0.0 && y >= 0.0 && x < self.columns as f64 && y < self.rows as f64) {
-            return None;
-        }
-        let k = self.nearest[y as usize * self.columns + x as usize];
+        self.at(self.column(p[0])?, self.row(p[1])?)
+    }
+
+    /// The column of the cells at abscissa `x`, if the grid covers it (not for NaN).
+    /// With [`NearestGrid::row`] and [`NearestGrid::at`] it is [`NearestGrid::nearest`]
+    /// in parts, for callers that look up every combination of a few abscissae and
+    /// ordinates (the correlative search's translations).
+    #[inline]
+    pub fn column(&self, x: f64) -> Option<usize> {
+        let x = (x - self.origin[0]) / self.cell;
+        (x >= 0.0 && x < self.columns as f64).then_some(x as usize)
+    }
+
+    /// The row of the cells at ordinate `y`, if the grid covers it (not for NaN).
+    #[inline]
+    pub fn row(&self, y: f64) -> Option<usize> {
+        let y = (y - self.origin[1]) / self.cell;
+        (y >= 0.0 && y < self.rows as f64).then_some(y as usize)
+    }
+
+    /// The point nearest to the centre of the cell at `column`, `row` (from
+    /// [`NearestGrid::column`] and [`NearestGrid::row`]), if one is within reach.
+    #[inline]
+    pub fn at(&self, column: usize, row: usize) -> Option<usize> {
+        let k = self.nearest[row * self.columns + column];
         (k != EMPTY).then_some(k as usize)
     }
 }
@@ -120,6 +138,26 @@ mod tests {
         assert_eq!(grid.nearest([0.33, 0.0]), None);
         assert_eq!(grid.nearest([f64::NAN, 0.0]), None);
         assert_eq!(grid.nearest([-5.0, 0.0]), None);
+    }
+
+    #[test]
+    fn column_row_and_cell_are_nearest_in_parts() {
+        let points: Vec<[f64; 2]> = (0..40)
+            .map(|i| [0.05 * i as f64, (0.3 * i as f64).sin()])
+            .collect();
+        let grid = NearestGrid::new(&points, 0.02, 0.15);
+        for i in -60..260 {
+            for j in -70..70 {
+                let p = [0.0087 * i as f64, 0.0191 * j as f64];
+                let parts = grid
+                    .column(p[0])
+                    .zip(grid.row(p[1]))
+                    .and_then(|(c, r)| grid.at(c, r));
+                assert_eq!(parts, grid.nearest(p), "{p:?}");
+            }
+        }
+        assert_eq!(grid.column(f64::NAN), None);
+        assert_eq!(grid.row(f64::INFINITY), None);
     }
 
     #[test]
