@@ -183,20 +183,18 @@ mod tests {
 
     /// What [`search`] stands for: every pose of the grid scored on its own, point
     /// after point, then the best distinct ones taken from a full sort.
-    #[allow(clippy::too_many_arguments)]
+    /// `window`: half widths (m, rad), level, how many to keep, how far apart.
     fn search_pose_by_pose(
-        grid: &NearestGrid,
-        reference: &[[f64; 2]],
-        current: &[[f64; 2]],
+        (grid, reference, current): (&NearestGrid, &[[f64; 2]], &[[f64; 2]]),
         centre: &Pose2,
-        half_xy: f64,
-        half_theta: f64,
-        level: Level,
-        keep: usize,
-        distinct: (f64, f64),
+        window: (f64, f64, Level, usize, (f64, f64)),
     ) -> Vec<Candidate> {
-        let nxy = (half_xy / level.step_xy).round() as i64;
-        let nth = (half_theta / level.step_theta).round() as i64;
+        let (half_xy, half_theta, level, keep, distinct) = window;
+        let steps = |half: f64, step: f64| (half / step).round() as i64;
+        let (nxy, nth) = (
+            steps(half_xy, level.step_xy),
+            steps(half_theta, level.step_theta),
+        );
         let mut all = Vec::new();
         for k in -nth..=nth {
             let theta = centre.theta + k as f64 * level.step_theta;
@@ -255,9 +253,7 @@ mod tests {
             let fast = search(
                 &grid, &reference, &current, &guess, args.0, args.1, args.2, args.3, args.4,
             );
-            let slow = search_pose_by_pose(
-                &grid, &reference, &current, &guess, args.0, args.1, args.2, args.3, args.4,
-            );
+            let slow = search_pose_by_pose((&grid, &reference, &current), &guess, args);
             // The same floating-point sums: equal to the bit.
             assert_eq!(fast, slow);
         }
