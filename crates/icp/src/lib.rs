@@ -63,8 +63,8 @@
 //!     followed by the exact point-to-line step against lines fitted over each
 //!     reference point's nearest neighbours (`neighbourhood_lines`), whichever rays
 //!     they come from. Distinct results that explain the scans about equally well
-//!     are refused as ambiguous; a result whose σ exceeds 3 mm / 0.3° is flagged
-//!     ill-conditioned.
+//!     are refused as ambiguous; a result uncertain along a wall is kept with its
+//!     covariance (only the condition number flags it ill-conditioned).
 //!
 //! ```no_run
 //! use odocal_icp::{IcpParams, Matcher, PreparedScan};
