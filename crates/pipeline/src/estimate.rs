@@ -56,8 +56,9 @@ impl Estimate {
             *intervals.select_nth_unstable_by(mid, f64::total_cmp).1
         };
         let scale = outcome.range_scale.sigma;
-        let covariance_total = odocal_solver::with_range_scale(&c.covariance, &c.params, scale);
-        let scale_only = odocal_solver::range_scale_covariance(&c.params, scale);
+        let direction = &c.scale_direction();
+        let covariance_total = odocal_solver::with_scale_along(&c.covariance, direction, scale);
+        let scale_only = odocal_solver::scale_covariance_along(direction, scale);
         Estimate {
             params: c.params.to_vector(),
             sigma: diagonal_sigma(&c.covariance),

@@ -178,6 +178,23 @@ pub struct Calibration {
     /// [`crate::fit_lateral_slip`]); `applied` when the estimate includes it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lateral_slip: Option<crate::LateralSlip>,
+    /// With held parameters or priors: how the estimate moves per unit of the
+    /// laser's range scale, in the order of [`crate::PARAMETER_NAMES`] (held entries
+    /// 0; see `range_scale.rs`). `None` when every parameter is free: then it is
+    /// [`crate::range_scale_direction`] of the estimate, whatever later replaces the
+    /// estimate (the slide's seven-parameter fit). See
+    /// [`Calibration::scale_direction`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub range_scale_response: Option<[f64; 6]>,
+}
+
+impl Calibration {
+    /// How the estimate moves per unit of the laser's range scale: the range scale's
+    /// covariance lies along it ([`crate::with_scale_along`]).
+    pub fn scale_direction(&self) -> [f64; 6] {
+        self.range_scale_response
+            .unwrap_or_else(|| crate::range_scale_direction(&self.params))
+    }
 }
 
 /// Closed form (step 1 and step 2) on all `samples`, without trimming: the
@@ -501,7 +518,11 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     for p in &active {
         used[p.index] = true;
     }
+    let range_scale_response = (!constraints.is_empty()).then(|| {
+        crate::range_scale::constrained_scale_direction(&active, &params, &weights, &constraints)
+    });
     Ok(Calibration {
+        range_scale_response,
         j: params.j(),
         params,
         closed_form: cf.params,

@@ -96,7 +96,10 @@ pub use observability::{
 };
 pub use one_sample::{describe as describe_one_sample, OneSampleSupport, ONE_SAMPLE_SIGMA_RATIO};
 pub use params::{Params, PARAMETER_NAMES};
-pub use range_scale::{range_scale_covariance, range_scale_direction, with_range_scale};
+pub use range_scale::{
+    range_scale_covariance, range_scale_direction, scale_covariance_along, with_range_scale,
+    with_scale_along,
+};
 pub use refine::Refinement;
 pub use sample::{ProfileSegment, Sample};
 pub use shared_scans::{SharedScanNoise, MIN_SHARED_SCANS};

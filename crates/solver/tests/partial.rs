@@ -223,3 +223,77 @@ fn accept_weak_returns_what_the_verdicts_refuse() {
         assert_eq!(rep.verdict, Verdict::NotExcited, "{name}");
     }
 }
+
+/// The laser's range scale with held parameters or priors: `range_scale_direction`
+/// is how the estimate moves when every scan-matched translation is longer by a
+/// relative `s` — checked here by doing it: the samples' translations scaled by
+/// `1 + s` and solved again. Free: the whole `(r_L, r_R, b, ℓx, ℓy, 0)`. With `b`
+/// held, `b` does not move and the radii move by less than their share (the
+/// rotations tie them to `b`); with a prior on `b` it moves by less than its share.
+#[test]
+fn range_scale_direction_is_how_the_estimate_moves_with_a_scaled_laser() {
+    let t = truth();
+    let tv = t.to_vector();
+    let mut samples = exact_samples(&mut rng(21), &t, 150, 3);
+    add_noise(&mut rng(22), &mut samples, [2e-3, 2e-3, 2e-3]);
+    // Weights given, not estimated from the residuals: a longer laser would also
+    // change the estimated σ (with held parameters the misfit grows), which moves a
+    // constrained estimate by a first-order amount of its own, not the scale's.
+    let v2 = 4e-6;
+    let cov = [[v2, 0.0, 0.0], [0.0, v2, 0.0], [0.0, 0.0, v2]];
+    let samples: Vec<Sample> = samples
+        .into_iter()
+        .map(|x| x.with_covariance(cov))
+        .collect();
+    let mut prior = Constraints::default();
+    prior.0[2] = Constraint::Prior {
+        mean: tv[2],
+        sigma: 1e-3,
+    };
+    let s = 1e-4;
+    for (name, constraints) in [
+        ("free", Constraints::default()),
+        ("b held", held(1 << 2, &tv)),
+        ("b and l_x held", held((1 << 2) | (1 << 3), &tv)),
+        ("b with a prior", prior),
+    ] {
+        let opts = options(constraints);
+        let base = calibrate(&samples, &opts).unwrap();
+        let scaled: Vec<Sample> = samples
+            .iter()
+            .map(|x| Sample {
+                sm: Pose2::new(x.sm.x * (1.0 + s), x.sm.y * (1.0 + s), x.sm.theta),
+                ..x.clone()
+            })
+            .collect();
+        let moved = calibrate(&scaled, &opts).unwrap();
+        let d = base.scale_direction();
+        let v = base.params.to_vector();
+        let diff = moved.params.difference(&base.params);
+        eprintln!("{name}: direction {d:.4?}, parameters {v:.4?}");
+        for i in 0..6 {
+            let measured = diff[i] / s;
+            // First order: within 1 % and 0.1 mm (or mrad) per unit of scale (free,
+            // with the translations' weights not scaled along, ℓθ moves by 0.04 mrad).
+            assert!(
+                (measured - d[i]).abs() <= 0.01 * d[i].abs() + 1e-4,
+                "{name} {i}: moved {measured:.6e}, direction {:.6e}",
+                d[i]
+            );
+            if constraints.is_held(i) {
+                assert_eq!(d[i], 0.0, "{name} {i}");
+            }
+        }
+        match name {
+            "free" => {
+                for i in 0..5 {
+                    assert!((d[i] - v[i]).abs() <= 1e-15 * v[i].abs().max(1.0), "{i}");
+                }
+                assert_eq!(d[5], 0.0);
+            }
+            "b held" => assert!(d[0].abs() < 0.9 * v[0] && d[1].abs() < 0.9 * v[1]),
+            "b with a prior" => assert!(d[2].abs() < 0.9 * v[2]),
+            _ => {}
+        }
+    }
+}
