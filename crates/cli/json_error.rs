@@ -20,12 +20,19 @@ pub fn error_object(error: &anyhow::Error, args: &[String]) -> Value {
         .find_map(|e| e.downcast_ref::<PipelineError>())
         .or(hold.map(|h| &h.refusal))
         .or(heading.map(|h| &h.refusal));
+    // Faults named beside a refusal, not as its cause: the refusal's own kind.
+    let pipeline = match pipeline {
+        Some(PipelineError::AlsoFound { refusal, .. }) => Some(&**refusal),
+        other => other,
+    };
     let kind = match pipeline {
         Some(PipelineError::Log(_)) => "log",
         Some(PipelineError::TooFewSamples { .. }) => "too_few_samples",
         Some(PipelineError::Solve(_)) => "solve",
         Some(PipelineError::NotDetermined { .. }) => "not_determined",
         Some(PipelineError::DataFault { .. }) => "data_fault",
+        // Unwrapped above; only too-few-samples refusals are wrapped.
+        Some(PipelineError::AlsoFound { .. }) => "too_few_samples",
         Some(PipelineError::InvalidSetting(_)) => "invalid_setting",
         Some(PipelineError::Implausible(_)) => "implausible",
         None if error.chain().any(|e| e.is::<LogError>()) => "log",

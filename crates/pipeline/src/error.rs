@@ -66,6 +66,16 @@ pub enum PipelineError {
         /// The underlying refusal.
         refusal: Box<PipelineError>,
     },
+    /// Too few samples, and the log has data faults that do not take pairs out (a
+    /// clock offset, slip): the refusal first, then the faults, not named as its
+    /// cause.
+    #[error("{refusal}; also found in the log (not the cause): {faults}")]
+    AlsoFound {
+        /// The refusal.
+        refusal: Box<PipelineError>,
+        /// The faults found (the warnings' messages, joined).
+        faults: String,
+    },
     /// A setting is out of range.
     #[error("invalid setting: {0}")]
     InvalidSetting(String),
@@ -90,6 +100,31 @@ impl PipelineError {
         let Some(faults) = crate::finding::explain(findings).filter(|_| refusal) else {
             return self;
         };
+        // Too few samples: only faults that take pairs out can be why; the others are
+        // named after the refusal.
+        if let PipelineError::TooFewSamples { .. } = self {
+            let (removing, others): (Vec<_>, Vec<_>) = findings
+                .iter()
+                .cloned()
+                .partition(|f| f.kind.removes_samples());
+            let refused = match crate::finding::explain(&others) {
+                Some(faults) if removing.is_empty() => {
+                    return PipelineError::AlsoFound {
+                        refusal: Box::new(self),
+                        faults,
+                    }
+                }
+                Some(others) => format!("; also found in the log (not the cause): {others}"),
+                None => String::new(),
+            };
+            let faults = crate::finding::explain(&removing).unwrap_or(faults);
+            let cause = format!("{}{refused}", too_few_cause(&self));
+            return PipelineError::DataFault {
+                faults,
+                cause,
+                refusal: Box::new(self),
+            };
+        }
         // The trajectory or the matching explains it: the faults are only also found
         // (those that are not the cause itself).
         let refused = match self {
@@ -112,25 +147,9 @@ impl PipelineError {
             }
             other => other,
         };
-        let cause = match &refused {
-            PipelineError::TooFewSamples {
-                usable,
-                pairs,
-                needed,
-                discarded,
-                match_rejections,
-                scan_returns,
-            } => format!(
-                "only {usable} usable sample(s) remain out of {pairs} scan pairs (discarded: \
-                 {}; at least {needed} are needed){}",
-                describe_discards(discarded),
-                why_too_few(discarded, match_rejections, *scan_returns)
-            ),
-            other => other.to_string(),
-        };
         PipelineError::DataFault {
             faults,
-            cause,
+            cause: refused.to_string(),
             refusal: Box::new(refused),
         }
     }
@@ -139,9 +158,31 @@ impl PipelineError {
     pub fn holds(&self) -> &[crate::refusal::Hold] {
         match self {
             PipelineError::NotDetermined { diagnosis, .. } => &diagnosis.holds,
-            PipelineError::DataFault { refusal, .. } => refusal.holds(),
+            PipelineError::DataFault { refusal, .. } | PipelineError::AlsoFound { refusal, .. } => {
+                refusal.holds()
+            }
             _ => &[],
         }
+    }
+}
+
+/// A too-few-samples refusal worded as the result of data faults ("only … remain").
+fn too_few_cause(refusal: &PipelineError) -> String {
+    match refusal {
+        PipelineError::TooFewSamples {
+            usable,
+            pairs,
+            needed,
+            discarded,
+            match_rejections,
+            scan_returns,
+        } => format!(
+            "only {usable} usable sample(s) remain out of {pairs} scan pairs (discarded: {}; \
+             at least {needed} are needed){}",
+            describe_discards(discarded),
+            why_too_few(discarded, match_rejections, *scan_returns)
+        ),
+        other => other.to_string(),
     }
 }
 
@@ -269,6 +310,64 @@ fn describe_discards(d: &DiscardCounts) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Too few samples with a fault that takes pairs out, and one that does not: only
+    /// the first is named as the cause; without it, the refusal is the matcher's and
+    /// the other is named after it as not the cause.
+    #[test]
+    fn too_few_samples_blame_only_faults_that_take_pairs_out() {
+        use crate::finding::{Finding, FindingKind};
+        let refusal = || {
+            let mut discarded = DiscardCounts::default();
+            let mut match_rejections = RejectionCounts::default();
+            for _ in 0..161 {
+                discarded.add(DiscardReason::MatchFailed);
+                match_rejections.add(Rejection::Correspondences);
+            }
+            PipelineError::TooFewSamples {
+                usable: 19,
+                pairs: 188,
+                needed: 20,
+                discarded,
+                match_rejections,
+                scan_returns: None,
+            }
+        };
+        let offset = Finding::warning(
+            FindingKind::ClockOffset,
+            "the laser clock looks offset from the encoder clock by about +0.17 s",
+        );
+        let gap = Finding::warning(FindingKind::Gap, "the encoder stream has a 12 s hole");
+        let alone = refusal().with_faults(std::slice::from_ref(&offset));
+        assert!(matches!(alone, PipelineError::AlsoFound { .. }));
+        let said = alone.to_string();
+        assert!(said.starts_with("only 19 usable sample(s)"), "{said}");
+        assert!(!said.contains("data faults"), "{said}");
+        assert!(
+            said.ends_with(
+                "; also found in the log (not the cause): the laser clock looks offset from \
+                 the encoder clock by about +0.17 s"
+            ),
+            "{said}"
+        );
+        let both = refusal().with_faults(&[offset, gap]);
+        assert!(matches!(both, PipelineError::DataFault { .. }));
+        let said = both.to_string();
+        assert!(
+            said.starts_with(
+                "the log has data faults: the encoder stream has a 12 s hole; as a result, \
+                 only 19 usable sample(s) remain"
+            ),
+            "{said}"
+        );
+        assert!(
+            said.ends_with(
+                "; also found in the log (not the cause): the laser clock looks offset from \
+                 the encoder clock by about +0.17 s"
+            ),
+            "{said}"
+        );
+    }
 
     fn too_few(discards: &[(DiscardReason, usize)], refused: &[(Rejection, usize)]) -> String {
         let mut discarded = DiscardCounts::default();

@@ -46,6 +46,25 @@ pub enum FindingKind {
 }
 
 impl FindingKind {
+    /// Whether a fault of this kind takes records or scan pairs out of the data
+    /// (repaired or left out: holes, jumps, repeats, frozen scans, impossible counts),
+    /// so that it can be why too few samples remain. The others (a clock offset, slip,
+    /// jitter, the checks of the result) leave every pair in.
+    pub fn removes_samples(self) -> bool {
+        matches!(
+            self,
+            FindingKind::EncoderWrap
+                | FindingKind::WheelAngleWrap
+                | FindingKind::ClockJump
+                | FindingKind::OutOfOrder
+                | FindingKind::Duplicate
+                | FindingKind::TimestampCollision
+                | FindingKind::FrozenScan
+                | FindingKind::EncoderSpike
+                | FindingKind::Gap
+        )
+    }
+
     /// The snake_case name used in the JSON.
     pub fn name(self) -> &'static str {
         match self {
