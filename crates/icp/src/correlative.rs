@@ -29,6 +29,10 @@ pub(crate) struct Candidate {
     pub score: f64,
 }
 
+/// Most translation steps the search takes each way from its centre (±6 m at the
+/// sparse matcher's coarse 6 cm).
+const MAX_STEPS: f64 = 100.0;
+
 /// The best poses of the grid `level` within `±half_xy` (m) and `±half_theta` (rad)
 /// of `centre`, at most `keep` of them, each a local maximum farther than
 /// `distinct_xy` / `distinct_theta` from every better one; best first.
@@ -44,8 +48,10 @@ pub(crate) fn search(
     keep: usize,
     distinct: (f64, f64),
 ) -> Vec<Candidate> {
-    let nxy = (half_xy / level.step_xy).round() as i64;
-    let nth = (half_theta / level.step_theta).round() as i64;
+    // Bounded whatever the window (a library caller's correction limits may be
+    // huge or infinite): at most MAX_STEPS steps each way, and a full turn.
+    let nxy = (half_xy / level.step_xy).round().min(MAX_STEPS) as i64;
+    let nth = (half_theta.min(std::f64::consts::PI) / level.step_theta).round() as i64;
     let offsets: Vec<f64> = (-nxy..=nxy).map(|i| i as f64 * level.step_xy).collect();
     let side = offsets.len();
     let inv_g2 = 1.0 / (level.gate * level.gate);
@@ -256,6 +262,31 @@ mod tests {
             let slow = search_pose_by_pose((&grid, &reference, &current), &guess, args);
             // The same floating-point sums: equal to the bit.
             assert_eq!(fast, slow);
+        }
+    }
+
+    #[test]
+    fn an_unbounded_window_is_searched_within_bounds() {
+        let (reference, current) = corner(&Pose2::new(0.05, 0.0, 0.1));
+        let grid = NearestGrid::new(&reference, 0.02, 0.15);
+        let level = Level {
+            step_xy: 0.06,
+            step_theta: 0.052,
+            gate: 0.15,
+        };
+        for half in [1e9, f64::INFINITY] {
+            let best = search(
+                &grid,
+                &reference,
+                &current[..20],
+                &Pose2::IDENTITY,
+                half,
+                half,
+                level,
+                3,
+                (0.08, 0.06),
+            );
+            assert!(!best.is_empty() && best.len() <= 3);
         }
     }
 
