@@ -71,6 +71,44 @@ fn urg_04lx_is_recognised_and_its_scale_reported_beside_the_data_sigma() {
     );
 }
 
+/// With a parameter held the scale does not move it (no scale term in its σ), and
+/// the free ones get the share the data give them: with `b` held the rotations tie
+/// the radii to it, so their scale term is below their whole share (1 % of the
+/// value); in the summary ℓθ's σ shows the small term it then gets.
+#[test]
+fn a_held_parameter_carries_no_scale_term() {
+    let free = calibrate_json(&["fixtures/demo.log"]);
+    let b = free["b"].as_f64().unwrap();
+    let held = calibrate_json(&["fixtures/demo.log", "--fix", &format!("b={b}")]);
+    let scale = array(&held, "/range_scale/sigma_from_scale");
+    assert_eq!(scale[2], 0.0);
+    for i in [0, 1] {
+        let value = held[["r_l", "r_r"][i]].as_f64().unwrap();
+        assert!(
+            scale[i] > 0.0 && scale[i] < 0.01 * value,
+            "{i}: {} of {value}",
+            scale[i]
+        );
+    }
+    assert!(scale[5] > 0.0, "{scale:?}");
+    let o = odocal(&["calibrate", "fixtures/demo.log", "--fix", &format!("b={b}")]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    let line = |name: &str| {
+        text.lines()
+            .find(|l| l.trim_start().starts_with(name))
+            .unwrap_or_else(|| panic!("no {name} line in {text}"))
+            .to_string()
+    };
+    assert!(
+        line("b ").contains("± 0.0000 mm (laser range scale 1 %)"),
+        "{text}"
+    );
+    assert!(
+        line("l_theta").contains("mrad (laser range scale 1 %)"),
+        "{text}"
+    );
+}
+
 #[test]
 fn lds_of_a_bag_is_recognised() {
     let v = calibrate_json(&["fixtures/bags/turtlebot_lds.bag"]);

@@ -93,7 +93,8 @@ impl RangeScale {
             _ => "laser not recognised".to_string(),
         };
         let turning = "how the robot turns per wheel rotation (J21, J22) and l_theta do not \
-                       depend on it";
+                       depend on it (while no parameter is held: a held one does not move \
+                       with it, and the others take the share the data give them)";
         match self.source {
             RangeScaleSource::Stated if self.applies() => format!(
                 "{sensor}; range scale ±{} % as stated ({RANGE_SCALE_OPTION}): r_L, r_R, b, \

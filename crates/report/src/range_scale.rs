@@ -15,7 +15,8 @@ pub struct RangeScaleReport {
     pub scale: RangeScale,
     /// What the run's distances rest on, in one sentence (as the summary prints it).
     pub statement: String,
-    /// Standard deviations the scale adds, order r_L, r_R, b, ℓx, ℓy, ℓθ (0 for ℓθ).
+    /// Standard deviations the scale adds, order r_L, r_R, b, ℓx, ℓy, ℓθ (0 for a
+    /// held parameter, and for ℓθ unless some parameters are held or have priors).
     pub sigma_from_scale: [f64; 6],
     /// Standard deviations of data and scale together (`sigma` is the data's alone).
     pub sigma_total: [f64; 6],
@@ -37,9 +38,10 @@ impl RangeScaleReport {
 
     /// The σ part of parameter `i`'s summary line: `± 0.2000 mm` with no scale term,
     /// `± 0.2000 mm (data) ± 0.7460 mm (laser range scale 1 %) = ± 0.7723 mm` with one
-    /// (ℓθ never has one). `unit` is the factor to the shown unit.
+    /// (ℓθ has one only when some parameters are held or have priors). `unit` is the
+    /// factor to the shown unit.
     pub fn sigma_words(&self, i: usize, data_sigma: f64, unit: f64, name: &str) -> String {
-        if !self.scale.applies() || i == 5 {
+        if !self.scale.applies() || (i == 5 && self.sigma_from_scale[5] == 0.0) {
             return format!("± {:.4} {name}", data_sigma * unit);
         }
         format!(

@@ -362,7 +362,19 @@ impl fmt::Display for Report {
                     }
                 })
                 .unwrap_or_default();
-            if i == 5 {
+            if i == 5 && self.range_scale.sigma_from_scale[5] > 0.0 {
+                // Parameters held or with priors: the range scale moves ℓθ a little.
+                writeln!(
+                    f,
+                    "  {:<8} = {:>+12.6} rad {}  ({:+.3}° ± {:.3}°)  {}",
+                    PARAMETER_NAMES[i],
+                    v[i],
+                    self.range_scale.sigma_words(i, self.sigma[i], 1e3, "mrad"),
+                    v[i].to_degrees(),
+                    self.range_scale.sigma_total[i].to_degrees(),
+                    verdict
+                )?;
+            } else if i == 5 {
                 writeln!(
                     f,
                     "  {:<8} = {:>+12.6} rad ± {:.6} rad  ({:+.3}° ± {:.3}°)  {}",
