@@ -37,11 +37,11 @@ pub fn range_scale_direction(params: &Params) -> [f64; 6] {
 /// about `10⁻⁸·N/σ²`, far above its relative tolerance of 10⁻¹²).
 const PROBE: f64 = 1e-4;
 
-/// How the estimate moves per unit of range scale. Without constraints it is
-/// [`range_scale_direction`] `p` exactly (the problem is invariant under scaling every
-/// distance). With held parameters or priors it is measured: every scan-matched
-/// translation is made longer by [`PROBE`] and the estimate refined again from where
-/// it is (held parameters stay, priors resist), the move divided by the probe. For
+/// How the estimate moves per unit of range scale, with held parameters or priors
+/// (without them it is [`range_scale_direction`] `p` exactly: the problem is invariant
+/// under scaling every distance, and the caller uses `p`). It is measured: every
+/// scan-matched translation is made longer by [`PROBE`] and the estimate refined again
+/// from where it is (held parameters stay, priors resist), the move divided by the probe. For
 /// example, with `b` held the rotations tie `r_L = −J21·b` and `r_R = J22·b`: the radii
 /// then move far less than their share, `b` not at all, and ℓθ a little. When that
 /// refinement does not converge to finite numbers, `p` with the held entries zeroed.
@@ -52,9 +52,6 @@ pub(crate) fn constrained_scale_direction(
     constraints: &Constraints,
 ) -> [f64; 6] {
     let p = range_scale_direction(params);
-    if constraints.is_empty() {
-        return p;
-    }
     let held_zeroed = std::array::from_fn(|i| if constraints.is_held(i) { 0.0 } else { p[i] });
     let longer: Vec<Packed> = samples
         .iter()
