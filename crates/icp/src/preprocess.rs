@@ -11,7 +11,7 @@
 //! On noise-free straight walls the local line is the wall itself.
 
 use crate::consistency::EXACT_NOISE_SHARE;
-use crate::neighbourhood_lines::NeighbourhoodLines;
+use crate::neighbourhood_lines::{NeighbourhoodLines, NOISE_RADIUS};
 use crate::{IcpError, IcpParams, NeighbourSearch};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 
@@ -196,7 +196,8 @@ impl PreparedScan {
             if n > MAX_NEIGHBOURHOOD_NOISE_POINTS {
                 return None;
             }
-            let lines = NeighbourhoodLines::new(&points, EXACT_NOISE_SHARE * max_valid_range);
+            let lines =
+                NeighbourhoodLines::new(&points, NOISE_RADIUS, EXACT_NOISE_SHARE * max_valid_range);
             let usable = lines.lines.iter().flatten().count();
             lines.noise_sigma.filter(|_| usable >= MIN_NOISE_LINES)
         });

@@ -25,7 +25,7 @@ use crate::correlative::{search, Candidate, Level};
 use crate::covariance::{InformationSum, RayResiduals};
 use crate::matcher::check_ending;
 use crate::nearest_grid::NearestGrid;
-use crate::neighbourhood_lines::{NeighbourhoodLine, NeighbourhoodLines};
+use crate::neighbourhood_lines::{NeighbourhoodLine, NeighbourhoodLines, MATCHING_RADIUS};
 use crate::range_noise::RangeBins;
 use crate::solve_step::NormalEquations;
 use crate::{IcpError, IcpParams, IcpResult, PreparedScan};
@@ -337,8 +337,9 @@ pub(crate) fn match_sparse(
     let (reference_points, _) = valid_points(reference);
     let (current_points, current_rays) = valid_points(current);
     let floor = 1e-5 * reference.max_valid_range.max(current.max_valid_range);
-    let lines = NeighbourhoodLines::new(&reference_points, floor);
-    let current_noise = NeighbourhoodLines::new(&current_points, floor).noise_sigma;
+    let lines = NeighbourhoodLines::new(&reference_points, MATCHING_RADIUS, floor);
+    let current_noise =
+        NeighbourhoodLines::new(&current_points, MATCHING_RADIUS, floor).noise_sigma;
     let noise = match (lines.noise_sigma, current_noise) {
         (Some(a), Some(b)) => a.max(b),
         (Some(a), None) | (None, Some(a)) => a,
