@@ -11,7 +11,7 @@
 //! On noise-free straight walls the local line is the wall itself.
 
 use crate::consistency::EXACT_NOISE_SHARE;
-use crate::neighbourhood_lines::{NeighbourhoodLines, NOISE_RADIUS};
+use crate::neighbourhood_lines::{NeighbourhoodLines, MAX_POINTS, NOISE_RADIUS};
 use crate::{IcpError, IcpParams, NeighbourSearch};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 
@@ -356,11 +356,10 @@ const SPARSE_SCAN_SHARE: f64 = 0.45;
 /// Fewest usable lines that show a scan's noise (windows or metric neighbourhoods).
 const MIN_NOISE_LINES: usize = 10;
 
-/// Most valid points whose noise is looked for in metric neighbourhoods: their search
-/// compares every pair (2048 points: ≈ 10 ms; 16 000 took 0.47 s a scan), and scans
-/// that need it are sparse (a URG-04LX's 682 rays, a Neato's 361). A denser scan
-/// without straight runs keeps its noise unknown.
-const MAX_NEIGHBOURHOOD_NOISE_POINTS: usize = 2048;
+/// Most valid points whose noise is looked for in metric neighbourhoods
+/// ([`MAX_POINTS`]: their search compares every pair). A denser scan without straight
+/// runs keeps its noise unknown.
+const MAX_NEIGHBOURHOOD_NOISE_POINTS: usize = MAX_POINTS;
 
 /// The readings a scan keeps, valid ones (finite, above `lo` and 0, below `hi`, m), in
 /// ray order; and per kept reading, whether it and the next kept one may be

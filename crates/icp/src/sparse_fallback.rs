@@ -25,7 +25,9 @@ use crate::correlative::{search, Candidate, Level};
 use crate::covariance::{InformationSum, RayResiduals};
 use crate::matcher::check_ending;
 use crate::nearest_grid::NearestGrid;
-use crate::neighbourhood_lines::{NeighbourhoodLine, NeighbourhoodLines, MATCHING_RADIUS};
+use crate::neighbourhood_lines::{
+    NeighbourhoodLine, NeighbourhoodLines, MATCHING_RADIUS, MAX_POINTS,
+};
 use crate::range_noise::RangeBins;
 use crate::solve_step::NormalEquations;
 use crate::{IcpError, IcpParams, IcpResult, PreparedScan};
@@ -96,8 +98,10 @@ fn not_finite(cov: &[[f64; 3]; 3]) -> bool {
 const COARSE_RAY_STEP: f64 = 0.7 * std::f64::consts::PI / 180.0;
 
 /// Should the pair be matched by [`match_sparse`]: the rays are coarse (at least
-/// [`COARSE_RAY_STEP`] apart) and one of the scans has fewer valid readings per full
-/// turn than [`IcpParams::sparse_below_returns`].
+/// [`COARSE_RAY_STEP`] apart), one of the scans has fewer valid readings per full
+/// turn than [`IcpParams::sparse_below_returns`], and neither has more valid points
+/// than the neighbourhood search takes ([`MAX_POINTS`]: a scan declaring thousands of
+/// coarse rays over many turns goes to the primary path, whose cost is linear).
 pub(crate) fn applies(
     reference: &PreparedScan,
     current: &PreparedScan,
@@ -105,7 +109,8 @@ pub(crate) fn applies(
 ) -> bool {
     let limit = params.sparse_below_returns as f64;
     let sparse = |s: &PreparedScan| s.ray_step >= COARSE_RAY_STEP && returns_per_turn(s) < limit;
-    sparse(reference) || sparse(current)
+    let searchable = |s: &PreparedScan| s.valid_count() <= MAX_POINTS;
+    (sparse(reference) || sparse(current)) && searchable(reference) && searchable(current)
 }
 
 /// The valid readings of `scan` per full turn of its field of view: a 240° laser with
@@ -577,5 +582,26 @@ mod tests {
         let with = crate::Matcher::new(params).match_scans(&reference, &reference, guess);
         let without = crate::Matcher::new(off).match_scans(&reference, &reference, guess);
         assert_eq!(with, without);
+    }
+
+    /// A scan declaring more coarse rays than a turn holds (a hostile file: 1° apart
+    /// over six turns, every one a return) beside a sparse one: not for the sparse
+    /// matcher, whose neighbourhood search compares every pair of points.
+    #[test]
+    fn a_scan_of_more_points_than_the_search_takes_goes_to_the_primary_path() {
+        let params = IcpParams::default();
+        let walls = room();
+        let sparse = prepare(&scan(&walls, &Pose2::IDENTITY, 3, 0), &params);
+        let n = MAX_POINTS + 100;
+        let many_angles: Vec<f64> = (0..n).map(|i| (i as f64).to_radians()).collect();
+        let many_ranges: Vec<f32> = many_angles
+            .iter()
+            .map(|&a| cast(&walls, [0.0, 0.0], a))
+            .collect();
+        let many = PreparedScan::new(&many_ranges, &many_angles, 0.06, 5.0, &params).unwrap();
+        assert!(many.valid_count() > MAX_POINTS, "{}", many.valid_count());
+        assert!(applies(&sparse, &sparse, &params));
+        assert!(!applies(&many, &sparse, &params));
+        assert!(!applies(&sparse, &many, &params));
     }
 }
