@@ -27,14 +27,14 @@ const CHI2_3_997: f64 = 14.16;
 /// A result comfortably well conditioned (condition number below this share of
 /// [`IcpParams::max_condition_number`]) is not tested: its cost has a clear bowl in
 /// every direction (clean scans of rooms and arenas; keeps the matcher's time).
-const TESTED_CONDITION_SHARE: f64 = 0.2;
+pub(crate) const TESTED_CONDITION_SHARE: f64 = 0.2;
 
 /// Two converged runs differ by up to this many times the convergence epsilons.
 const CONVERGENCE_SPREAD: f64 = 3.0;
 
 /// The squared Mahalanobis distance of `d` (x, y, θ) under `cov` (∞ when `cov` is
 /// not invertible).
-fn mahalanobis_sq(d: [f64; 3], cov: &[[f64; 3]; 3]) -> f64 {
+pub(crate) fn mahalanobis_sq(d: [f64; 3], cov: &[[f64; 3]; 3]) -> f64 {
     let m = nalgebra::Matrix3::from_fn(|r, c| cov[r][c]);
     let v = nalgebra::Vector3::from(d);
     match m.try_inverse() {

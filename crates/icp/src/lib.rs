@@ -52,11 +52,16 @@
 //!    correspondences found again; where that cost rises less than the covariance
 //!    predicts (a washboard: noisy short lines, each shift finds new ones), the
 //!    variance along the axis is widened by the ratio.
-//! 10. `rotation_search`: when the attempt from the first guess fails or is refused,
+//! 10. `small_objects`: a result that is not comfortably well conditioned and takes
+//!     much of its information from small objects standing in front of the walls (a
+//!     person's legs, a chair) is matched again without them; when the two disagree
+//!     (a person walking drags the iterations where the walls leave a direction
+//!     weak), its covariance is widened by their difference.
+//! 11. `rotation_search`: when the attempt from the first guess fails or is refused,
 //!     the matcher starts again from the rotations where the two scans' histograms
 //!     of line directions agree best (translation-independent); two distinct
 //!     consistent results are refused as ambiguous.
-//! 11. `sparse_fallback`: a pair where a scan's rays are coarse (≥ 0.7° apart) and
+//! 12. `sparse_fallback`: a pair where a scan's rays are coarse (≥ 0.7° apart) and
 //!     its returns few (fewer than [`IcpParams::sparse_below_returns`] per full turn:
 //!     a 1° LDS with most readings missing) is matched instead by a correlative grid
 //!     search over `(x, y, θ)` (`correlative`, on the `nearest_grid` lookup table)
@@ -94,6 +99,7 @@ mod params;
 mod preprocess;
 mod range_noise;
 mod rotation_search;
+mod small_objects;
 mod solve_step;
 mod sparse_fallback;
 mod trimming;

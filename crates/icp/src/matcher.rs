@@ -5,6 +5,7 @@ use crate::correspondence::{nearest_by_angle, nearest_by_tree, segment_for};
 use crate::covariance::{conditioning, InformationSum, RayResiduals};
 use crate::range_noise::RangeBins;
 use crate::rotation_search::candidate_rotations;
+use crate::small_objects::UsedTerm;
 use crate::solve_step::NormalEquations;
 use crate::trimming::threshold;
 use crate::{IcpError, IcpParams, NeighbourSearch, PreparedScan};
@@ -143,6 +144,13 @@ pub struct Matcher {
     /// The cost envelope's fixed correspondences (current point, line normal, offset,
     /// weight; module `cost_envelope`).
     fixed_lines: Vec<([f64; 2], [f64; 2], f64, f64)>,
+    /// The correspondences the last refinement used at its result (module
+    /// `small_objects`).
+    pub(crate) used_terms: Vec<UsedTerm>,
+    /// Those of the result being checked, while the checks run again.
+    pub(crate) kept_terms: Vec<UsedTerm>,
+    /// Per valid current point: left out of the correspondences (empty: none).
+    pub(crate) skipped: Vec<bool>,
 }
 
 impl Matcher {
@@ -157,6 +165,9 @@ impl Matcher {
             ray_residuals: RayResiduals::default(),
             range_bins: RangeBins::default(),
             fixed_lines: Vec::new(),
+            used_terms: Vec::new(),
+            kept_terms: Vec::new(),
+            skipped: Vec::new(),
         }
     }
 
@@ -206,9 +217,21 @@ impl Matcher {
             use_tree,
         ) {
             Ok(result) => {
+                // The small-object test needs the correspondences of this result, which
+                // the basin test's runs replace.
+                std::mem::swap(&mut self.used_terms, &mut self.kept_terms);
                 let result =
                     self.basin_checked(reference, current, result, first_guess, &params, use_tree);
-                return Ok(self.envelope_widened(reference, current, result, &params, use_tree));
+                let result = self.envelope_widened(reference, current, result, &params, use_tree);
+                return Ok(self.small_objects_widened(
+                    reference,
+                    current,
+                    result,
+                    first_guess,
+                    first_guess,
+                    &params,
+                    use_tree,
+                ));
             }
             Err(e) => e,
         };
@@ -219,7 +242,9 @@ impl Matcher {
             params.max_angular_correction,
             params.rotation_hypotheses + 1,
         );
-        let mut found: Option<IcpResult> = None;
+        // The consistent result found, its start, and its correspondences (for the
+        // small-object test).
+        let mut found: Option<(IcpResult, Pose2, Vec<UsedTerm>)> = None;
         let mut starts = 1;
         for theta in candidates
             .into_iter()
@@ -232,10 +257,11 @@ impl Matcher {
             else {
                 continue;
             };
+            let terms = self.used_terms.clone();
             found = match found {
-                None => Some(result),
+                None => Some((result, start, terms)),
                 Some(best) => {
-                    let apart = best.pose.between(&result.pose);
+                    let apart = best.0.pose.between(&result.pose);
                     let apart_theta = wrap_angle(apart.theta).abs();
                     if apart.translation_norm() > DISTINCT_XY || apart_theta > DISTINCT_THETA {
                         return Err(IcpError::Ambiguous {
@@ -243,8 +269,8 @@ impl Matcher {
                             apart_deg: apart_theta.to_degrees(),
                         });
                     }
-                    Some(if result.matched_share > best.matched_share {
-                        result
+                    Some(if result.matched_share > best.0.matched_share {
+                        (result, start, terms)
                     } else {
                         best
                     })
@@ -252,10 +278,20 @@ impl Matcher {
             };
         }
         match found {
-            Some(result) => {
+            Some((result, start, terms)) => {
+                self.kept_terms = terms;
                 let result =
                     self.basin_checked(reference, current, result, first_guess, &params, use_tree);
                 let result = self.envelope_widened(reference, current, result, &params, use_tree);
+                let result = self.small_objects_widened(
+                    reference,
+                    current,
+                    result,
+                    start,
+                    first_guess,
+                    &params,
+                    use_tree,
+                );
                 Ok(IcpResult { starts, ..result })
             }
             None => Err(first_error),
@@ -553,12 +589,24 @@ impl Matcher {
             self.range_bins.push(k.q[0].hypot(k.q[1]), e * e * k.weight);
         }
         let noise_variances = self.range_bins.variances();
+        self.used_terms.clear();
         for (k, &v) in self.correspondences.iter().zip(noise_variances) {
             if k.normalized_sq > tau_sq {
                 continue;
             }
             let e = residual(k);
             sum_abs += e.abs();
+            // ∂e/∂θ: the normal against the point's rotation derivative.
+            let dq = [-s * k.q[0] - c * k.q[1], c * k.q[0] - s * k.q[1]];
+            self.used_terms.push(UsedTerm {
+                index: (k.key >> 32) as u32,
+                j: [
+                    k.normal[0],
+                    k.normal[1],
+                    k.normal[0] * dq[0] + k.normal[1] * dq[1],
+                ],
+                w: k.weight,
+            });
             info.add(
                 current.original[(k.key >> 32) as usize] as usize,
                 k.q,
@@ -587,7 +635,7 @@ impl Matcher {
             weakest_direction: unc.weakest_direction,
             residual_spread: robust_spread(&mut self.squared_residuals),
             noise_sigma: scans_noise(reference, current, params),
-            matched_share: (used as f64 / current.lined_count.max(1) as f64).min(1.0),
+            matched_share: (used as f64 / self.lined_not_skipped(current).max(1) as f64).min(1.0),
             starts: 1,
         };
         let result = if result.matched_share < params.min_matched_share {
@@ -604,6 +652,25 @@ impl Matcher {
         };
         check_consistency(&result, params)?;
         Ok(result)
+    }
+
+    /// True when current point `k` is left out of the correspondences.
+    #[inline]
+    fn is_skipped(&self, k: usize) -> bool {
+        self.skipped.get(k).copied().unwrap_or(false)
+    }
+
+    /// The current scan's points with a local line, less those left out.
+    fn lined_not_skipped(&self, current: &PreparedScan) -> usize {
+        if self.skipped.is_empty() {
+            return current.lined_count;
+        }
+        current
+            .incidence_cos
+            .iter()
+            .zip(&self.skipped)
+            .filter(|(c, &skip)| !c.is_nan() && !skip)
+            .count()
     }
 
     /// The normal equations of the used correspondences without the
@@ -635,7 +702,7 @@ impl Matcher {
         let (s, c) = estimate.theta.sin_cos();
         let mut count = 0;
         for (k, &q) in current.points.iter().enumerate() {
-            if current.incidence_cos[k].is_nan() {
+            if current.incidence_cos[k].is_nan() || self.is_skipped(k) {
                 continue;
             }
             let p = placed(estimate, (s, c), q);
@@ -676,6 +743,9 @@ impl Matcher {
         self.correspondences.clear();
         let (s, c) = estimate.theta.sin_cos();
         for (k, &q) in current.points.iter().enumerate() {
+            if self.is_skipped(k) {
+                continue;
+            }
             let p = placed(estimate, (s, c), q);
             let nearest = self.nearest_reference(reference, p, k, gate2, use_tree);
             let Some(j) = nearest else { continue };
