@@ -376,7 +376,7 @@ fn measurement_finds_the_clean_presets_clean() {
 /// 1008–1012: 182 mm off with a σ of 2.9 mm, NEES 4,721). The matcher now matches such a
 /// pair again without the small objects in front of the walls and widens the result's
 /// covariance by the difference (`crates/icp/src/small_objects.rs`): the accepted
-/// matches' mean NEES was 40.3, and is 13.0 (that pair's σ along the hall 26 mm), the
+/// matches' mean NEES was 40.3, and is 11.2 (that pair's σ along the hall 26 mm), the
 /// matched share unchanged (94 %).
 #[test]
 fn people_walking_past_the_rover_do_not_make_its_matches_overconfident() {

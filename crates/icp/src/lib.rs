@@ -52,9 +52,10 @@
 //!    correspondences found again; where that cost rises less than the covariance
 //!    predicts (a washboard: noisy short lines, each shift finds new ones), the
 //!    variance along the axis is widened by the ratio.
-//! 10. `small_objects`: a result that is not comfortably well conditioned and takes
-//!     much of its information from small objects standing in front of the walls (a
-//!     person's legs, a chair) is matched again without them; when the two disagree
+//! 10. `small_objects`: a result that takes much of its information from small
+//!     objects standing in front of the walls (a person's legs, a chair), and whose
+//!     walls alone are not comfortably well conditioned, is matched again without
+//!     them; when the two disagree
 //!     (a person walking drags the iterations where the walls leave a direction
 //!     weak), its covariance is widened by their difference.
 //! 11. `rotation_search`: when the attempt from the first guess fails or is refused,

@@ -10,14 +10,17 @@
 //! 2.9 mm). Which objects moved, two scans cannot tell. That the result rests on them,
 //! they can: when the small objects in front of the rest (see
 //! [`foreground_small_objects`]) together give at least [`MIN_SHARE`] of the
-//! information along some direction, the pair is matched again from the same start
-//! without their points. When the two results are farther apart than their covariances
+//! information along some direction, and the information of the other points is not
+//! comfortably well conditioned (condition number at least ⅕ of the limit, as for the
+//! basin test: otherwise the walls hold every direction whatever the objects do), the
+//! pair is matched again from the same start without their points. When the two results are farther apart than their covariances
 //! allow, the result is kept and its covariance widened by their difference `d dᵀ`, as
 //! the basin test does: the calibration then weighs it by what it may really be worth.
 //! Refusing such pairs instead was measured and not kept: on the real MinesRover logs it
 //! cost matches and the two logs' agreement (docs/benchmarks.md).
 
-use crate::basin_check::{mahalanobis_sq, TESTED_CONDITION_SHARE};
+use crate::basin_check::{mahalanobis_sq, rms_range, TESTED_CONDITION_SHARE};
+use crate::covariance::conditioning;
 use crate::{IcpParams, IcpResult, Matcher, PreparedScan};
 use odocal_geom::{wrap_angle, Pose2};
 
@@ -120,20 +123,26 @@ pub(crate) fn foreground_small_objects(points: &[[f64; 2]]) -> Vec<bool> {
 }
 
 /// The current points of `terms` flagged in `on_small`, when together they give at
-/// least [`MIN_SHARE`] of the information of `terms` along some direction; `None`
-/// otherwise.
-pub(crate) fn small_object_points(terms: &[UsedTerm], on_small: &[bool]) -> Option<Vec<u32>> {
+/// least [`MIN_SHARE`] of the information of `terms` along some direction, with the
+/// information of the other terms; `None` otherwise.
+pub(crate) fn small_object_points(
+    terms: &[UsedTerm],
+    on_small: &[bool],
+) -> Option<(Vec<u32>, [[f64; 3]; 3])> {
     let mut full = [[0.0; 3]; 3];
     let mut small = [[0.0; 3]; 3];
+    let mut rest = [[0.0; 3]; 3];
     let mut points = Vec::new();
     for t in terms {
         add(&mut full, t);
         if on_small.get(t.index as usize).copied().unwrap_or(false) {
             add(&mut small, t);
             points.push(t.index);
+        } else {
+            add(&mut rest, t);
         }
     }
-    (!points.is_empty() && largest_share(&full, &small) >= MIN_SHARE).then_some(points)
+    (!points.is_empty() && largest_share(&full, &small) >= MIN_SHARE).then_some((points, rest))
 }
 
 impl Matcher {
@@ -151,13 +160,18 @@ impl Matcher {
         params: &IcpParams,
         use_tree: bool,
     ) -> IcpResult {
-        if result.condition_number < TESTED_CONDITION_SHARE * params.max_condition_number {
-            return result;
-        }
         let on_small = foreground_small_objects(&current.points);
-        let Some(points) = small_object_points(&self.kept_terms, &on_small) else {
+        let Some((points, rest)) = small_object_points(&self.kept_terms, &on_small) else {
             return result;
         };
+        // The rest comfortably well conditioned: the walls hold every direction
+        // whatever the objects do.
+        let rest_held = conditioning(&rest, rms_range(current).max(1e-3)).is_some_and(|c| {
+            c.condition_number < TESTED_CONDITION_SHARE * params.max_condition_number
+        });
+        if rest_held {
+            return result;
+        }
         self.skipped.clear();
         self.skipped.resize(current.points.len(), false);
         for i in points {
@@ -274,7 +288,10 @@ mod tests {
         assert!((largest_share(&full, &part) - 0.75).abs() < 1e-12);
         let mut on_small = vec![false; 4];
         on_small[1] = true;
-        assert_eq!(small_object_points(&terms, &on_small), Some(vec![1]));
+        assert_eq!(
+            small_object_points(&terms, &on_small).map(|(points, _)| points),
+            Some(vec![1])
+        );
         // A term giving a fifth of the information along x is below the least share.
         let weak = [
             term(0, [1.0, 0.0, 0.0], 4.0),
