@@ -50,6 +50,25 @@ pub(crate) fn mahalanobis_sq(d: [f64; 3], cov: &[[f64; 3]; 3]) -> f64 {
     }
 }
 
+/// `to − from` in the parameters a result's covariance is of: `(x, y, θ)`, the angle
+/// wrapped.
+pub(crate) fn difference(from: &Pose2, to: &Pose2) -> [f64; 3] {
+    [
+        to.x - from.x,
+        to.y - from.y,
+        odocal_geom::wrap_angle(to.theta - from.theta),
+    ]
+}
+
+/// `cov` widened by the spread `d` between two results: `cov + d dᵀ`.
+pub(crate) fn widen(cov: &mut [[f64; 3]; 3], d: [f64; 3]) {
+    for (r, row) in cov.iter_mut().enumerate() {
+        for (c, v) in row.iter_mut().enumerate() {
+            *v += d[r] * d[c];
+        }
+    }
+}
+
 /// `result.pose` moved by `step` (m) along the unit direction `weak` of `(x, y, ρθ)`.
 fn moved(pose: &Pose2, weak: [f64; 3], step: f64, rho: f64) -> Pose2 {
     Pose2::new(
@@ -106,18 +125,10 @@ impl Matcher {
             let Ok(again) = self.refine(reference, current, start, anchor, params, use_tree) else {
                 continue;
             };
-            let d = [
-                again.pose.x - result.pose.x,
-                again.pose.y - result.pose.y,
-                odocal_geom::wrap_angle(again.pose.theta - result.pose.theta),
-            ];
+            let d = difference(&result.pose, &again.pose);
             if mahalanobis_sq(d, &judged) > CHI2_3_997 {
                 result.ill_conditioned = true;
-                for (r, row) in result.covariance.iter_mut().enumerate() {
-                    for (c, v) in row.iter_mut().enumerate() {
-                        *v += d[r] * d[c];
-                    }
-                }
+                widen(&mut result.covariance, d);
                 break;
             }
         }

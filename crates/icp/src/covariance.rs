@@ -184,6 +184,7 @@ impl<'a> InformationSum<'a> {
     /// once), reference line normal, residual and weight (inverse residual variance up
     /// to the common factor σ̂²), and `noise_variance`, the variance of its weighted
     /// residual `√w·e` (from the residuals at its range: module `range_noise`).
+    /// Returns the residual's Jacobian `∂e/∂(x, y, θ)` at the sums' pose.
     pub fn add(
         &mut self,
         ray: usize,
@@ -192,7 +193,7 @@ impl<'a> InformationSum<'a> {
         residual: f64,
         w: f64,
         noise_variance: f64,
-    ) {
+    ) -> [f64; 3] {
         if let (Some(r), Some(p)) = (
             self.rays.residual.get_mut(ray),
             self.rays.present.get_mut(ray / 64),
@@ -223,6 +224,7 @@ impl<'a> InformationSum<'a> {
         self.sum_sq += w * residual * residual;
         self.sum_r2 += q[0] * q[0] + q[1] * q[1];
         self.count += 1;
+        j
     }
 
     /// Number of correspondences added.

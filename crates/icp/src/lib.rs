@@ -55,9 +55,8 @@
 //! 10. `small_objects`: a result that takes much of its information from small
 //!     objects standing in front of the walls (a person's legs, a chair), and whose
 //!     walls alone are not comfortably well conditioned, is matched again without
-//!     them; when the two disagree
-//!     (a person walking drags the iterations where the walls leave a direction
-//!     weak), its covariance is widened by their difference.
+//!     them; when the two disagree (a person walking drags the iterations where the
+//!     walls leave a direction weak), its covariance is widened by their difference.
 //! 11. `rotation_search`: when the attempt from the first guess fails or is refused,
 //!     the matcher starts again from the rotations where the two scans' histograms
 //!     of line directions agree best (translation-independent); two distinct

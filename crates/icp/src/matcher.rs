@@ -257,7 +257,7 @@ impl Matcher {
             else {
                 continue;
             };
-            let terms = self.used_terms.clone();
+            let terms = std::mem::take(&mut self.used_terms);
             found = match found {
                 None => Some((result, start, terms)),
                 Some(best) => {
@@ -596,18 +596,7 @@ impl Matcher {
             }
             let e = residual(k);
             sum_abs += e.abs();
-            // ∂e/∂θ: the normal against the point's rotation derivative.
-            let dq = [-s * k.q[0] - c * k.q[1], c * k.q[0] - s * k.q[1]];
-            self.used_terms.push(UsedTerm {
-                index: (k.key >> 32) as u32,
-                j: [
-                    k.normal[0],
-                    k.normal[1],
-                    k.normal[0] * dq[0] + k.normal[1] * dq[1],
-                ],
-                w: k.weight,
-            });
-            info.add(
+            let j = info.add(
                 current.original[(k.key >> 32) as usize] as usize,
                 k.q,
                 k.normal,
@@ -615,6 +604,11 @@ impl Matcher {
                 k.weight,
                 v,
             );
+            self.used_terms.push(UsedTerm {
+                index: (k.key >> 32) as u32,
+                j,
+                w: k.weight,
+            });
         }
         let used = info.count();
         let unc = info.finish().ok_or(IcpError::Numerical {

@@ -13,28 +13,29 @@
 //! information along some direction, and the information of the other points is not
 //! comfortably well conditioned (condition number at least ⅕ of the limit, as for the
 //! basin test: otherwise the walls hold every direction whatever the objects do), the
-//! pair is matched again from the same start without their points. When the two results are farther apart than their covariances
-//! allow, the result is kept and its covariance widened by their difference `d dᵀ`, as
-//! the basin test does: the calibration then weighs it by what it may really be worth.
+//! pair is matched again from the same start without their points. When the two results
+//! are farther apart than their covariances allow, the result is kept and its
+//! covariance widened by their difference `d dᵀ`, as the basin test does: the
+//! calibration then weighs it by what it may really be worth.
 //! Refusing such pairs instead was measured and not kept: on the real MinesRover logs it
 //! cost matches and the two logs' agreement (docs/benchmarks.md).
 
-use crate::basin_check::{mahalanobis_sq, rms_range, TESTED_CONDITION_SHARE};
+use crate::basin_check::{difference, mahalanobis_sq, rms_range, widen, TESTED_CONDITION_SHARE};
 use crate::covariance::conditioning;
 use crate::{IcpParams, IcpResult, Matcher, PreparedScan};
-use odocal_geom::{wrap_angle, Pose2};
+use odocal_geom::Pose2;
 
 /// Consecutive valid points farther apart than this (m) are different objects.
-pub(crate) const CLUSTER_GAP: f64 = 0.15;
+const CLUSTER_GAP: f64 = 0.15;
 /// An object less than this across (m, the bounding-box diagonal of its points) is
 /// small: a person's legs, a chair, a bin, a pillar.
-pub(crate) const SMALL_OBJECT: f64 = 0.6;
+const SMALL_OBJECT: f64 = 0.6;
 /// How much farther from the sensor (m) the points beside a small object must be for
 /// it to stand in front of them.
-pub(crate) const FOREGROUND_STEP: f64 = 0.3;
+const FOREGROUND_STEP: f64 = 0.3;
 /// The small objects' least share of the information along some direction for the
 /// result to be tested.
-pub(crate) const MIN_SHARE: f64 = 0.3;
+const MIN_SHARE: f64 = 0.3;
 /// χ²(3)'s 99.9 % level.
 const CHI2_3_999: f64 = 16.27;
 
@@ -185,23 +186,12 @@ impl Matcher {
         if again.ill_conditioned {
             return result;
         }
-        let d = [
-            again.pose.x - result.pose.x,
-            again.pose.y - result.pose.y,
-            wrap_angle(again.pose.theta - result.pose.theta),
-        ];
-        let mut judged = again.covariance;
-        for (r, row) in judged.iter_mut().enumerate() {
-            for (c, v) in row.iter_mut().enumerate() {
-                *v += result.covariance[r][c];
-            }
-        }
+        let d = difference(&result.pose, &again.pose);
+        let judged: [[f64; 3]; 3] = std::array::from_fn(|r| {
+            std::array::from_fn(|c| again.covariance[r][c] + result.covariance[r][c])
+        });
         if mahalanobis_sq(d, &judged) > CHI2_3_999 {
-            for (r, row) in result.covariance.iter_mut().enumerate() {
-                for (c, v) in row.iter_mut().enumerate() {
-                    *v += d[r] * d[c];
-                }
-            }
+            widen(&mut result.covariance, d);
         }
         result
     }
