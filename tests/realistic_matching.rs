@@ -397,7 +397,7 @@ fn turtlebot4_rplidar_matches_without_wrong_matches() {
 }
 
 /// What the matcher can promise instead of "none beyond 5 mm / 0.5°" (the three ignored
-/// tests above): on these lasers, whose range noise grows with range (σ = 5–6 mm +
+/// tests above): on these lasers, whose range noise grows with range (σ = 3–6 mm +
 /// 0.25–0.5 %·r), a match along a wall or over far points is uncertain by more than
 /// 5 mm, and it is kept with that covariance because the calibration needs it
 /// (`tests/sparse_calibration.rs`). So the accepted matches beyond 5 mm / 0.5° must be
