@@ -3,20 +3,10 @@
 //! repository, skipped with a notice when absent): how many of the pairs the scan
 //! matcher matches, and that every refusal is counted by its reason.
 
-use odocal_pipeline::{calibrate_log, NoProgress, Options, Rejection};
-use std::path::PathBuf;
+mod common;
 
-fn mines_log(name: &str) -> Option<PathBuf> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/real/mines")
-        .join(name);
-    if path.exists() {
-        Some(path)
-    } else {
-        println!("skipped: {} is absent", path.display());
-        None
-    }
-}
+use common::mines_log;
+use odocal_pipeline::{calibrate_log, NoProgress, Options, Rejection};
 
 #[test]
 fn most_pairs_of_the_real_mines_logs_match_and_every_refusal_has_its_reason() {

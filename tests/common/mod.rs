@@ -86,3 +86,17 @@ pub fn calibrate_json(args: &[&str]) -> serde_json::Value {
     assert!(o.status.success(), "{}", stderr(&o));
     serde_json::from_slice(&o.stdout).expect("one JSON object")
 }
+
+/// The real MinesRover log `name` (`exp1.log`, `exp2.log`) from `../shared/real/mines`
+/// beside the repository; `None`, with a notice on standard output, when it is absent.
+pub fn mines_log(name: &str) -> Option<PathBuf> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/real/mines")
+        .join(name);
+    if path.exists() {
+        Some(path)
+    } else {
+        println!("skipped: {} is absent", path.display());
+        None
+    }
+}

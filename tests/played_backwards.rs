@@ -1,0 +1,180 @@
+//! A log played backwards holds the same data: the robot drives the same path in
+//! reverse, every scan pair is matched with its two scans' roles exchanged, and a
+//! calibration without a preferred direction finds the same robot. The difference
+//! between the two calibrations is an error of the matching (or of the pipeline)
+//! measured without ground truth.
+//!
+//! Measured (docs/benchmarks.md, "Logs played backwards"): the clean Khepera log moves
+//! by 0.09 % (r_L); the realistic rover by 0.1–0.7 %; the real MinesRover logs by
+//! 1–3 % (exp1: r_L 74.65 → 72.42 mm, b 297.3 → 287.2 mm), two to four times the
+//! simulated rover on identical data: a direction-dependent matching error of the real
+//! scans that the realistic presets do not reproduce at that size, not fixed yet.
+
+mod common;
+
+use common::mines_log;
+use odocal_log::{EncoderRecord, Log, ScanGeometry, ScanStore};
+use odocal_pipeline::{calibrate_log, NoProgress, Options};
+use odocal_sim::{simulate_in, SimConfig, World};
+
+/// `log` played backwards: every record at `t_first + t_last − t`, in the new time
+/// order; the encoder counts as they are (the wheels turn backwards); the rays of each
+/// scan in reverse order (a negative angular step), stamped with the time of the last
+/// ray so that the sweep still runs forward in time. The firmware's odometry poses
+/// are left out.
+fn played_backwards(log: &Log) -> Log {
+    let sweep_end = |t: f64, g: &ScanGeometry| t + g.sweep_duration();
+    let times = log.encoders.iter().map(|e| e.t).chain(
+        log.scans
+            .iter()
+            .flat_map(|s| [s.t, sweep_end(s.t, s.geometry)]),
+    );
+    let (first, last) = times.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| {
+        (lo.min(t), hi.max(t))
+    });
+    let mirror = first + last;
+    let encoders: Vec<EncoderRecord> = log
+        .encoders
+        .iter()
+        .rev()
+        .map(|e| EncoderRecord {
+            t: mirror - e.t,
+            ..*e
+        })
+        .collect();
+    let mut scans = ScanStore::default();
+    let all: Vec<_> = log.scans.iter().collect();
+    for s in all.iter().rev() {
+        let g = s.geometry;
+        let angles: Vec<f64> = g.angles.iter().rev().copied().collect();
+        let geometry = ScanGeometry {
+            start_angle: angles[0],
+            resolution: -g.resolution,
+            angles: angles.into(),
+            ..g.clone()
+        };
+        let ranges: Vec<f32> = s.ranges.iter().rev().copied().collect();
+        scans.push(
+            mirror - sweep_end(s.t, g),
+            &geometry,
+            &ranges,
+            s.kind,
+            s.line,
+        );
+    }
+    Log {
+        encoders,
+        odom: Vec::new(),
+        scans,
+        ..log.clone()
+    }
+}
+
+/// Forward and backward calibrations of `log`: the six parameters and their data σ.
+fn both_ways(log: &Log) -> [([f64; 6], [f64; 6]); 2] {
+    let opts = Options {
+        accept_weak: true,
+        ..Options::default()
+    };
+    [log.clone(), played_backwards(log)].map(|l| {
+        let c = calibrate_log(&l, &opts, &NoProgress)
+            .unwrap_or_else(|e| panic!("refused: {e}"))
+            .calibration;
+        let sigma = std::array::from_fn(|i| c.covariance[i][i].sqrt());
+        (c.params.to_vector(), sigma)
+    })
+}
+
+/// A 120 s log of `preset` with `seed`.
+fn simulated(preset: &str, seed: u64) -> Log {
+    let mut config = SimConfig::preset(preset).unwrap();
+    config.seed = seed;
+    config.duration = 120.0;
+    let world = World::preset(&config.world).unwrap();
+    simulate_in(&config, &world).unwrap().to_log()
+}
+
+const NAMES: [&str; 6] = ["r_L", "r_R", "b", "l_x", "l_y", "l_theta"];
+
+/// Prints the two calibrations and returns the relative differences of r_L, r_R, b
+/// and the differences of ℓx, ℓy (m) and ℓθ (rad), backward minus forward.
+fn report(label: &str, log: &Log) -> [f64; 6] {
+    let [(f, fs), (b, _)] = both_ways(log);
+    let d: [f64; 6] = std::array::from_fn(|i| {
+        if i < 3 {
+            b[i] / f[i] - 1.0
+        } else {
+            b[i] - f[i]
+        }
+    });
+    for i in 0..6 {
+        println!(
+            "{label} {}: forward {:.5} ± {:.5}, backward {:.5} ({})",
+            NAMES[i],
+            f[i],
+            fs[i],
+            b[i],
+            if i < 3 {
+                format!("{:+.2} %", 100.0 * d[i])
+            } else {
+                format!("{:+.5}", d[i])
+            }
+        );
+    }
+    d
+}
+
+#[test]
+fn a_clean_log_calibrates_the_same_played_backwards() {
+    // Measured: r_L −0.09 %, r_R −0.09 %, b −0.09 %, ℓx −0.17 mm, ℓy −0.07 mm, ℓθ
+    // +0.24 mrad (seed 7, 120 s; data σ of r_L 0.04 %): the pipeline's own preference
+    // for a direction of time, on scans that match exactly, is this small.
+    let d = report("khepera", &simulated("khepera", 7));
+    for (i, limit) in [0.002, 0.002, 0.002, 5e-4, 5e-4, 1e-3]
+        .into_iter()
+        .enumerate()
+    {
+        assert!(d[i].abs() < limit, "{}: {:+e} backwards", NAMES[i], d[i]);
+    }
+}
+
+#[test]
+fn a_swept_log_calibrates_the_same_played_backwards() {
+    // The reversal keeps each sweep running forward in time (the rays in reverse order
+    // from the last one's time): the realistic rover (0.6 m/s, a 67 ms sweep, people,
+    // range bias, mixed pixels) calibrates the same both ways to within the 1 %
+    // range-scale σ. Measured: seed 8 r_L −0.14 %, r_R −0.19 %, b −0.07 %; seeds 7 and 9
+    // (the same reversal written as a Carmen log) r_L −0.7 % and −0.5 %. This is the
+    // level the real logs are held to by the ignored test below (they move 1–3 %). The
+    // sweep stamped at the wrong end (the first ray's time, 67 ms off) moves seed 8
+    // by +0.4 %: under this bound, which is not what the test is for.
+    let d = report("mines-rover", &simulated("mines-rover", 8));
+    for (i, &di) in d.iter().enumerate().take(3) {
+        assert!(
+            di.abs() < 0.01,
+            "{}: {:+.2} % backwards",
+            NAMES[i],
+            100.0 * di
+        );
+    }
+}
+
+#[test]
+#[ignore = "issue 20's open problem, fails today: the real MinesRover logs move 1–3 % when played backwards (printed on demand)"]
+fn the_real_logs_calibrate_the_same_played_backwards() {
+    // The target: the real logs move no more than the simulated rover (1 % on the
+    // radii and b). Today: exp1 r_L −3.0 %, b −3.4 %; exp2 r_L −1.1 %, b −2.1 %.
+    // `cargo test --release --test played_backwards -- --ignored --nocapture`.
+    let mut failures = Vec::new();
+    for name in ["exp1.log", "exp2.log"] {
+        let Some(path) = mines_log(name) else { return };
+        let log = odocal_log::read_log(&path, &Default::default()).unwrap();
+        let d = report(name, &log);
+        for (i, &di) in d.iter().enumerate().take(3) {
+            if di.abs() >= 0.01 {
+                failures.push(format!("{name} {}: {:+.2} %", NAMES[i], 100.0 * di));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "moved backwards: {failures:?}");
+}
