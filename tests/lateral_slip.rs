@@ -7,7 +7,7 @@
 mod common;
 
 use common::accuracy::calibrate;
-use common::{cleanup, simulated_log};
+use common::{cleanup, mines_log, simulated_log};
 use odocal_pipeline::{FindingKind, Options, SlideModel};
 use odocal_report::Report;
 
@@ -253,14 +253,9 @@ fn the_real_mines_logs_show_the_slide_and_say_so() {
     // it moves ℓx by 34 mm) and 0.058 ± 0.033 s on exp2 (1.8σ: a note naming
     // --lateral-slip). Before, 0.044 ± 0.017 and −0.053 ± 0.041. Each log gets a
     // finding that says so; estimated, the two logs' k agree within 3σ.
-    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/real/mines");
     let mut slides = Vec::new();
     for name in ["exp1.log", "exp2.log"] {
-        let path = dir.join(name);
-        if !path.exists() {
-            println!("skipped: {} is absent", path.display());
-            return;
-        }
+        let Some(path) = mines_log(name) else { return };
         let auto = calibrate(&path, &with_model(SlideModel::Auto));
         let slip = auto.lateral_slip.expect("the slide is checked");
         let said = auto
@@ -305,14 +300,9 @@ fn the_real_mines_logs_together_estimate_one_slide() {
     // --no-lateral-slip; before the joint solve had the slide it gave 121.5 ± 8.1 mm
     // "well determined". The robot's nominal mounting: 145 mm.
     use odocal_pipeline::{calibrate_logs, NoProgress};
-    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/real/mines");
     let mut logs = Vec::new();
     for name in ["exp1.log", "exp2.log"] {
-        let path = dir.join(name);
-        if !path.exists() {
-            println!("skipped: {} is absent", path.display());
-            return;
-        }
+        let Some(path) = mines_log(name) else { return };
         logs.push(odocal_log::read_log(&path, &Default::default()).expect("the log reads"));
     }
     let named: Vec<(&str, &odocal_log::Log)> = vec![("exp1.log", &logs[0]), ("exp2.log", &logs[1])];

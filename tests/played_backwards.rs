@@ -48,8 +48,8 @@ fn played_backwards(log: &Log, skip: usize) -> (Log, f64) {
         })
         .collect();
     let mut scans = ScanStore::default();
-    let all: Vec<_> = log.scans.iter().collect();
-    for s in all.iter().rev().skip(skip) {
+    let last_first = (0..log.scans.len()).rev().skip(skip);
+    for s in last_first.filter_map(|i| log.scans.get(i)) {
         let g = s.geometry;
         let angles: Vec<f64> = g.angles.iter().rev().copied().collect();
         let geometry = ScanGeometry {
@@ -101,7 +101,7 @@ fn both_ways(log: &Log) -> BothWays {
         .samples
         .iter()
         .map(|s| {
-            let pose = s.to_solver(false, false).sm.inverse();
+            let pose = s.icp.pose.inverse();
             (key(mirror - s.pair.t1, mirror - s.pair.t0), pose)
         })
         .collect();
@@ -110,7 +110,7 @@ fn both_ways(log: &Log) -> BothWays {
         .samples
         .iter()
         .filter_map(|s| {
-            let f = s.to_solver(false, false).sm;
+            let f = s.icp.pose;
             let b = matches.get(&key(s.pair.t0, s.pair.t1))?;
             (f.translation_norm() > MIN_TRANSLATION)
                 .then(|| b.translation_norm() / f.translation_norm())
