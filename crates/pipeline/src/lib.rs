@@ -74,7 +74,7 @@ pub use joint::{
 pub use lasers::{laser_indices, LaserSetup};
 pub use lateral_slip::SlideModel;
 pub use odocal_solver::Trim;
-pub use options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
+pub use options::{Options, BOOTSTRAP_PAIRS, BOOTSTRAP_RUN, MIN_SAMPLES};
 pub use progress::{NoProgress, Progress};
 pub use range_finder::{recognise, LaserSignature, RangeFinder, RANGE_FINDERS};
 pub use range_scale::{RangeScale, RangeScaleSource};

@@ -6,7 +6,7 @@ use crate::error::PipelineError;
 use crate::finding::{Finding, FindingKind};
 use crate::health;
 use crate::matching::{match_pairs, typical_noise_sigma, with_typical_noise, MatchStats};
-use crate::options::{Options, BOOTSTRAP_PAIRS, MIN_SAMPLES};
+use crate::options::{Options, BOOTSTRAP_PAIRS, BOOTSTRAP_RUN, MIN_SAMPLES};
 use crate::progress::Progress;
 use crate::refusal;
 use crate::rejection::{MatchFailure, Rejection, RejectionCounts};
@@ -62,6 +62,21 @@ pub struct Outcome {
     /// sheet of the range finder recognised in the log); the calibration's covariance
     /// is the data's alone, [`crate::Estimate`] gives both.
     pub range_scale: crate::RangeScale,
+}
+
+/// The indices of the pairs the bootstrap matches from identity guesses, of `kept`
+/// pairs: all of them when there are fewer than twice [`BOOTSTRAP_PAIRS`]; otherwise
+/// runs of [`BOOTSTRAP_RUN`] consecutive pairs spread evenly over the log, one run in
+/// every `kept / BOOTSTRAP_PAIRS`, so that both the subset and the pairs left are
+/// chains whose scans are prepared once.
+fn bootstrap_subset(kept: usize) -> Vec<usize> {
+    if kept < 2 * BOOTSTRAP_PAIRS {
+        return (0..kept).collect();
+    }
+    let every = kept / BOOTSTRAP_PAIRS;
+    (0..kept)
+        .filter(|i| (i / BOOTSTRAP_RUN) % every == 0)
+        .collect()
 }
 
 /// Ticks per revolution from the options or the log, checking the log has what
@@ -187,12 +202,7 @@ pub fn synchronize_and_match(
         // every pair of short ones), solve roughly, and guess the rest — and the
         // subset's failures — by odometry with that estimate (with a sweep:
         // compensate with it too).
-        let every = (kept.len() / BOOTSTRAP_PAIRS).max(1);
-        let subset: Vec<usize> = if kept.len() >= 2 * BOOTSTRAP_PAIRS {
-            (0..kept.len()).step_by(every).collect()
-        } else {
-            (0..kept.len()).collect()
-        };
+        let subset = bootstrap_subset(kept.len());
         let sub_pairs: Vec<(usize, usize)> = subset.iter().map(|&i| index_pairs[i]).collect();
         let identity = vec![Pose2::IDENTITY; subset.len()];
         let results = match_pairs(&log.scans, &sub_pairs, &identity, &log_icp, || {
@@ -775,4 +785,40 @@ fn edge_warning(
              search with `--time-offset-range {wider}`"
         ),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_short_log_bootstraps_on_every_pair() {
+        let n = 2 * BOOTSTRAP_PAIRS - 1;
+        assert_eq!(bootstrap_subset(n), (0..n).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn a_long_log_bootstraps_on_evenly_spread_runs_of_consecutive_pairs() {
+        for n in [2 * BOOTSTRAP_PAIRS, 1499, 10_000] {
+            let subset = bootstrap_subset(n);
+            // About BOOTSTRAP_PAIRS of them (one in every n / BOOTSTRAP_PAIRS).
+            assert!(
+                subset.len() >= BOOTSTRAP_PAIRS - BOOTSTRAP_RUN
+                    && subset.len() <= 2 * BOOTSTRAP_PAIRS,
+                "{n} pairs: {}",
+                subset.len()
+            );
+            // Runs of BOOTSTRAP_RUN consecutive pairs (the last one possibly cut by
+            // the end), the same distance apart, from the first pair to the last
+            // tenth of the log.
+            let runs: Vec<&[usize]> = subset.chunk_by(|a, b| b == &(a + 1)).collect::<Vec<_>>();
+            for run in &runs[..runs.len() - 1] {
+                assert_eq!(run.len(), BOOTSTRAP_RUN, "{n} pairs");
+            }
+            let gaps: Vec<usize> = runs.windows(2).map(|w| w[1][0] - w[0][0]).collect();
+            assert!(gaps.iter().all(|&g| g == gaps[0]), "{n} pairs: {gaps:?}");
+            assert_eq!(subset[0], 0);
+            assert!(*subset.last().unwrap() >= n - n / 10, "{n} pairs");
+        }
+    }
 }
