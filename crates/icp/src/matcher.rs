@@ -586,7 +586,10 @@ impl Matcher {
         for k in &self.correspondences {
             let e = residual(k);
             self.squared_residuals.push(e * e * k.weight);
-            self.range_bins.push(k.q[0].hypot(k.q[1]), e * e * k.weight);
+            // The range as √(x² + y²): `hypot`'s care for overflow is not needed at a
+            // laser's ranges, and it was 2 % of `calibrate`'s CPU.
+            let range = (k.q[0] * k.q[0] + k.q[1] * k.q[1]).sqrt();
+            self.range_bins.push(range, e * e * k.weight);
         }
         let noise_variances = self.range_bins.variances();
         self.used_terms.clear();

@@ -89,13 +89,16 @@ fn largest_share(full: &[[f64; 3]; 3], part: &[[f64; 3]; 3]) -> f64 {
 /// neighbours are the same wall.
 pub(crate) fn foreground_small_objects(points: &[[f64; 2]]) -> Vec<bool> {
     let mut flags = vec![false; points.len()];
-    let range = |p: [f64; 2]| p[0].hypot(p[1]);
+    // Distances as √(x² + y²) and compared squared: `hypot`'s care for overflow is not
+    // needed at a laser's ranges, and it costs.
+    let range = |p: [f64; 2]| (p[0] * p[0] + p[1] * p[1]).sqrt();
+    let squared = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
     let mut start = 0;
     while start < points.len() {
         let mut end = start + 1;
         while end < points.len() {
             let (a, b) = (points[end - 1], points[end]);
-            if (a[0] - b[0]).hypot(a[1] - b[1]) > CLUSTER_GAP {
+            if squared(a, b) > CLUSTER_GAP * CLUSTER_GAP {
                 break;
             }
             end += 1;
@@ -107,7 +110,7 @@ pub(crate) fn foreground_small_objects(points: &[[f64; 2]]) -> Vec<bool> {
                 hi[a] = hi[a].max(p[a]);
             }
         }
-        let small = (hi[0] - lo[0]).hypot(hi[1] - lo[1]) < SMALL_OBJECT;
+        let small = squared(hi, lo) < SMALL_OBJECT * SMALL_OBJECT;
         let before = (start > 0).then(|| range(points[start - 1]) - range(points[start]));
         let after = (end < points.len()).then(|| range(points[end]) - range(points[end - 1]));
         let in_front = (before.is_some() || after.is_some())
