@@ -14,11 +14,10 @@
 
 mod common;
 
-use common::mines_log;
+use common::{mines_log, simulated_120s};
 use odocal_geom::Pose2;
 use odocal_log::{EncoderRecord, Log, ScanGeometry, ScanStore};
 use odocal_pipeline::{calibrate_log, NoProgress, Options};
-use odocal_sim::{simulate_in, SimConfig, World};
 use std::collections::BTreeMap;
 
 /// `log` played backwards: every record at `t_first + t_last − t`, in the new time
@@ -146,15 +145,6 @@ struct BothWays {
     length_ratio: f64,
 }
 
-/// A 120 s log of `preset` with `seed`.
-fn simulated(preset: &str, seed: u64) -> Log {
-    let mut config = SimConfig::preset(preset).unwrap();
-    config.seed = seed;
-    config.duration = 120.0;
-    let world = World::preset(&config.world).unwrap();
-    simulate_in(&config, &world).unwrap().to_log()
-}
-
 const NAMES: [&str; 6] = ["r_L", "r_R", "b", "l_x", "l_y", "l_theta"];
 
 /// Prints the two calibrations and returns the relative differences of r_L, r_R, b
@@ -198,7 +188,7 @@ fn a_clean_log_calibrates_the_same_played_backwards() {
     // 120 s; data σ of r_L 0.04 %), the matches' translations the same both ways
     // (median ratio 1.0000 over 134 pairs): the pipeline's own preference for a
     // direction of time, on scans that match exactly, is this small.
-    let (d, length_ratio) = report("khepera", &simulated("khepera", 7));
+    let (d, length_ratio) = report("khepera", &simulated_120s("khepera", 7));
     assert!((length_ratio - 1.0).abs() < 1e-3, "{length_ratio}");
     for (i, limit) in [0.002, 0.002, 0.002, 5e-4, 5e-4, 1e-3]
         .into_iter()
@@ -220,7 +210,7 @@ fn a_swept_log_calibrates_the_same_played_backwards() {
     // It is a bound on the matching's preference for a direction, not a check of the
     // reversal: the sweep stamped at the wrong end (the first ray's time, 67 ms off)
     // gives +0.10 %, +0.06 %, +0.06 %.
-    let (d, length_ratio) = report("mines-rover", &simulated("mines-rover", 8));
+    let (d, length_ratio) = report("mines-rover", &simulated_120s("mines-rover", 8));
     assert!((length_ratio - 1.0).abs() < 0.01, "{length_ratio}");
     for (i, &di) in d.iter().enumerate().take(3) {
         assert!(

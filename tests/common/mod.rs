@@ -4,7 +4,7 @@
 
 pub mod accuracy;
 
-use odocal_sim::{simulate, SimConfig};
+use odocal_sim::{simulate, simulate_in, SimConfig, World};
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
@@ -55,6 +55,17 @@ pub fn simulated_log(
         .expect("write the log");
     let p = run.ground_truth(&summary).params;
     (path, p.to_array())
+}
+
+/// A 120 s log of `preset` with `seed`, in memory.
+pub fn simulated_120s(preset: &str, seed: u64) -> odocal_log::Log {
+    let mut config = SimConfig::preset(preset).expect("preset exists");
+    config.seed = seed;
+    config.duration = 120.0;
+    let world = World::preset(&config.world).expect("the preset's world exists");
+    simulate_in(&config, &world)
+        .expect("simulation runs")
+        .to_log()
 }
 
 /// Removes a test's directory (best effort).
