@@ -14,7 +14,7 @@
 
 mod common;
 
-use common::{mines_log, simulated_120s};
+use common::{mines_log, rays_listed_backwards, simulated_120s};
 use odocal_geom::Pose2;
 use odocal_log::{EncoderRecord, Log, ScanGeometry, ScanStore};
 use odocal_pipeline::{calibrate_log, NoProgress, Options};
@@ -49,17 +49,9 @@ fn played_backwards(log: &Log, skip: usize) -> (Log, f64) {
     let mut scans = ScanStore::default();
     let last_first = (0..log.scans.len()).rev().skip(skip);
     for s in last_first.filter_map(|i| log.scans.get(i)) {
-        let g = s.geometry;
-        let angles: Vec<f64> = g.angles.iter().rev().copied().collect();
-        let geometry = ScanGeometry {
-            start_angle: angles[0],
-            resolution: -g.resolution,
-            angles: angles.into(),
-            ..g.clone()
-        };
-        let ranges: Vec<f32> = s.ranges.iter().rev().copied().collect();
+        let (geometry, ranges) = rays_listed_backwards(s.geometry, s.ranges);
         scans.push(
-            mirror - sweep_end(s.t, g),
+            mirror - sweep_end(s.t, s.geometry),
             &geometry,
             &ranges,
             s.kind,

@@ -18,26 +18,18 @@
 
 mod common;
 
-use common::{mines_log, simulated_120s};
-use odocal_log::{Log, ScanGeometry, ScanStore};
+use common::{mines_log, rays_listed_backwards, simulated_120s};
+use odocal_log::{Log, ScanStore};
 use odocal_pipeline::{calibrate_log, NoProgress, Options};
 
 /// `log` with every scan's rays listed the other way (see the module documentation).
 fn rays_reversed(log: &Log) -> Log {
     let mut scans = ScanStore::default();
     for s in log.scans.iter() {
-        let g = s.geometry;
-        let angles: Vec<f64> = g.angles.iter().rev().copied().collect();
-        let geometry = ScanGeometry {
-            start_angle: angles[0],
-            resolution: -g.resolution,
-            time_increment: -g.time_increment,
-            angles: angles.into(),
-            ..g.clone()
-        };
-        let ranges: Vec<f32> = s.ranges.iter().rev().copied().collect();
-        // The ray listed first now is the one that was listed last.
-        let t = s.t + g.sweep_duration();
+        let (mut geometry, ranges) = rays_listed_backwards(s.geometry, s.ranges);
+        // Fired from the ray now listed last: the one listed first was fired last.
+        geometry.time_increment = -geometry.time_increment;
+        let t = s.t + s.geometry.sweep_duration();
         scans.push(t, &geometry, &ranges, s.kind, s.line);
     }
     Log {

@@ -68,6 +68,22 @@ pub fn simulated_120s(preset: &str, seed: u64) -> odocal_log::Log {
         .to_log()
 }
 
+/// A scan's geometry and readings with its rays listed the other way: the angles and
+/// readings reversed, the angular step negated (the sweep's timing left as it is).
+pub fn rays_listed_backwards(
+    g: &odocal_log::ScanGeometry,
+    ranges: &[f32],
+) -> (odocal_log::ScanGeometry, Vec<f32>) {
+    let angles: Vec<f64> = g.angles.iter().rev().copied().collect();
+    let geometry = odocal_log::ScanGeometry {
+        start_angle: angles[0],
+        resolution: -g.resolution,
+        angles: angles.into(),
+        ..g.clone()
+    };
+    (geometry, ranges.iter().rev().copied().collect())
+}
+
 /// Removes a test's directory (best effort).
 pub fn cleanup(path: &Path) {
     if let Some(dir) = path.parent() {

@@ -811,7 +811,7 @@ mod tests {
             // Runs of BOOTSTRAP_RUN consecutive pairs (the last one possibly cut by
             // the end), the same distance apart, from the first pair to the last
             // tenth of the log.
-            let runs: Vec<&[usize]> = subset.chunk_by(|a, b| b == &(a + 1)).collect::<Vec<_>>();
+            let runs: Vec<&[usize]> = subset.chunk_by(|a, b| b == &(a + 1)).collect();
             for run in &runs[..runs.len() - 1] {
                 assert_eq!(run.len(), BOOTSTRAP_RUN, "{n} pairs");
             }
