@@ -107,6 +107,10 @@ pub struct PreparedScan {
     /// k-d tree over the valid points, built when the k-d search is asked for or the
     /// angles do not allow the angular search.
     pub(crate) tree: Option<PointTree>,
+    /// The points of several scans placed in one frame ([`PreparedScan::from_points`]),
+    /// not one scan's rays: matched by the sparse matcher, whose lines come from
+    /// metric neighbourhoods, never from consecutive rays.
+    pub(crate) cloud: bool,
 }
 
 /// Window statistics of a local line fit.
@@ -267,7 +271,43 @@ impl PreparedScan {
             tilt_noise_scale,
             noise_sigma,
             tree,
+            cloud: false,
         })
+    }
+
+    /// Prepares a point cloud (m, in one sensor frame): the points of a scan and of
+    /// its neighbours placed in its frame, which a pair of sparse scans too poor to
+    /// match alone is matched with. Pairs with a cloud are matched by the sparse
+    /// matcher (lines through metric neighbourhoods of the points; see the crate
+    /// documentation) when the clouds hold at most 2,048 points each; the order of the
+    /// points does not matter (they are taken by bearing).
+    ///
+    /// Errors: fewer than `params.min_valid_points` finite points within
+    /// `params.min_reading` and `params.max_reading` of the origin, or invalid
+    /// parameters.
+    pub fn from_points(points: &[[f64; 2]], params: &IcpParams) -> Result<PreparedScan, IcpError> {
+        let mut polar: Vec<(f64, f32)> = points
+            .iter()
+            .filter(|p| p[0].is_finite() && p[1].is_finite())
+            .map(|p| (p[1].atan2(p[0]), (p[0] * p[0] + p[1] * p[1]).sqrt() as f32))
+            .collect();
+        polar.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        let angles: Vec<f64> = polar.iter().map(|p| p.0).collect();
+        let ranges: Vec<f32> = polar.iter().map(|p| p.1).collect();
+        let mut cloud = PreparedScan::new(&ranges, &angles, 0.0, f64::INFINITY, params)?;
+        cloud.cloud = true;
+        Ok(cloud)
+    }
+
+    /// Would a pair with this scan be matched by the sparse matcher (coarse rays and
+    /// few returns per turn: a 1° LDS), whatever the other scan?
+    pub fn is_sparse(&self, params: &IcpParams) -> bool {
+        crate::sparse_fallback::sparse_scan(self, params)
+    }
+
+    /// The valid readings' points (m, sensor frame), in ray order.
+    pub fn points(&self) -> &[[f64; 2]] {
+        &self.points
     }
 
     /// Range noise the scan shows about its own local lines (σ, m; `None` when it has

@@ -102,15 +102,22 @@ const COARSE_RAY_STEP: f64 = 0.7 * std::f64::consts::PI / 180.0;
 /// turn than [`IcpParams::sparse_below_returns`], and neither has more valid points
 /// than the neighbourhood search takes ([`MAX_POINTS`]: a scan declaring thousands of
 /// coarse rays over many turns goes to the primary path, whose cost is linear).
+/// A point cloud ([`PreparedScan::from_points`]) is always matched here.
 pub(crate) fn applies(
     reference: &PreparedScan,
     current: &PreparedScan,
     params: &IcpParams,
 ) -> bool {
-    let limit = params.sparse_below_returns as f64;
-    let sparse = |s: &PreparedScan| s.ray_step >= COARSE_RAY_STEP && returns_per_turn(s) < limit;
+    let sparse = |s: &PreparedScan| s.cloud || sparse_scan(s, params);
     let searchable = |s: &PreparedScan| s.valid_count() <= MAX_POINTS;
     (sparse(reference) || sparse(current)) && searchable(reference) && searchable(current)
+}
+
+/// The scan's rays are coarse and it has few returns per turn (see [`applies`]).
+pub(crate) fn sparse_scan(scan: &PreparedScan, params: &IcpParams) -> bool {
+    scan.ray_step >= COARSE_RAY_STEP
+        && returns_per_turn(scan) < params.sparse_below_returns as f64
+        && scan.valid_count() <= MAX_POINTS
 }
 
 /// The valid readings of `scan` per full turn of its field of view: a 240° laser with
@@ -529,6 +536,43 @@ mod tests {
             .match_scans(&reference, &current, guess)
             .unwrap();
         assert_eq!(via.pose, r.pose);
+    }
+
+    /// Scans densified by neighbours placed exactly in their frames
+    /// ([`PreparedScan::from_points`]): the clouds' match is exact, and a cloud takes
+    /// this path even when it is dense.
+    #[test]
+    fn clouds_of_placed_neighbours_recover_the_displacement_exactly() {
+        let params = IcpParams::default();
+        let walls = room();
+        let poses = [
+            Pose2::new(0.0, -0.25, 0.2),
+            Pose2::new(0.1, -0.2, 0.3),
+            Pose2::new(0.22, -0.15, 0.38),
+            Pose2::new(0.3, -0.1, 0.45),
+        ];
+        let cloud = |anchor: usize, other: usize, phases: (usize, usize)| {
+            let own = prepare(&scan(&walls, &poses[anchor], 3, phases.0), &params);
+            let near = prepare(&scan(&walls, &poses[other], 3, phases.1), &params);
+            let place = poses[anchor].between(&poses[other]);
+            let mut points = own.points().to_vec();
+            points.extend(near.points().iter().map(|p| place.transform_point(*p)));
+            PreparedScan::from_points(&points, &params).unwrap()
+        };
+        let reference = cloud(1, 0, (0, 1));
+        let current = cloud(2, 3, (2, 0));
+        let truth = poses[1].between(&poses[2]);
+        let guess = Pose2::new(truth.x - 0.03, truth.y + 0.02, truth.theta - 0.03);
+        let r = crate::Matcher::new(params.clone())
+            .match_scans(&reference, &current, guess)
+            .unwrap();
+        let e = truth.between(&r.pose);
+        assert!(e.translation_norm() < 1e-5 && e.theta.abs() < 1e-5, "{e}");
+        assert!(!r.ill_conditioned, "{r:?}");
+        let whole = prepare(&scan(&walls, &poses[1], 1, 0), &params);
+        let dense = PreparedScan::from_points(whole.points(), &params).unwrap();
+        assert!(!dense.is_sparse(&params) && applies(&dense, &dense, &params));
+        assert!(PreparedScan::from_points(&[[1.0, 0.0]; 3], &params).is_err());
     }
 
     #[test]
