@@ -21,7 +21,7 @@ use crate::matching::{match_pairs, MatchStats};
 use crate::rejection::{MatchFailure, Rejection};
 use crate::samples::wheel_only_sample;
 use crate::sweep::compensate_into;
-use crate::sync::{EncoderTrack, SyncLimits};
+use crate::sync::{DiscardReason, EncoderTrack, SyncLimits};
 use odocal_geom::Pose2;
 use odocal_icp::IcpParams;
 use odocal_log::ScanStore;
@@ -64,19 +64,29 @@ impl LinkSource<'_> {
     /// The first guess of the displacement from scan `i` to scan `j`: odometry over
     /// the interval with the estimate, identity without one or where the wheels
     /// stood still or the counts do not cover the interval.
-    fn guess(&self, predictor: Option<&Predictor>, i: usize, j: usize) -> Pose2 {
-        let (Some(predictor), Some(&t0), Some(&t1)) =
-            (predictor, self.scan_times.get(i), self.scan_times.get(j))
-        else {
-            return Pose2::IDENTITY;
-        };
-        match self
-            .track
-            .motion(t0 - self.time_offset, t1 - self.time_offset, self.limits)
-        {
-            Ok(w) => Pose2::from_array(predictor.predict(&wheel_only_sample(&w))),
-            Err(_) => Pose2::IDENTITY,
-        }
+    pub(crate) fn guess(&self, predictor: Option<&Predictor>, i: usize, j: usize) -> Pose2 {
+        predictor
+            .and_then(|p| self.odometry(p, i, j))
+            .unwrap_or(Pose2::IDENTITY)
+    }
+
+    /// The displacement of the sensor from scan `i` to scan `j` (either order) by
+    /// odometry with `predictor`'s estimate; `None` where the counts do not cover the
+    /// interval or the synchronization limits refuse it; the identity where the wheels
+    /// stood still.
+    pub(crate) fn odometry(&self, predictor: &Predictor, i: usize, j: usize) -> Option<Pose2> {
+        let (&ti, &tj) = (self.scan_times.get(i)?, self.scan_times.get(j)?);
+        let (t0, t1) = (ti.min(tj), ti.max(tj));
+        let forward =
+            match self
+                .track
+                .motion(t0 - self.time_offset, t1 - self.time_offset, self.limits)
+            {
+                Ok(w) => Pose2::from_array(predictor.predict(&wheel_only_sample(&w))),
+                Err(DiscardReason::RobotStill) => Pose2::IDENTITY,
+                Err(_) => return None,
+            };
+        Some(if tj >= ti { forward } else { forward.inverse() })
     }
 }
 
@@ -253,6 +263,7 @@ pub fn compose(links: &[MatchStats]) -> Option<MatchStats> {
         residual_sum += link.mean_residual * link.correspondences as f64;
         correspondence_sum += link.correspondences;
         out.links += link.links;
+        out.neighbours += link.neighbours;
     }
     out.mean_residual = residual_sum / correspondence_sum.max(1) as f64;
     Some(out)
@@ -284,6 +295,7 @@ mod tests {
             correspondences: 300,
             mean_residual: 0.002,
             links: 1,
+            neighbours: 0,
         }
     }
 

@@ -43,6 +43,7 @@ pub mod input_files;
 pub mod joint;
 pub mod lasers;
 pub mod lateral_slip;
+pub mod local_map;
 pub mod log_agreement;
 pub mod match_quality;
 pub mod matcher_bias;

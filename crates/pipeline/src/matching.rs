@@ -24,6 +24,26 @@ pub struct MatchStats {
     /// Matches composed into ŝ: 1 for the pair's own match, more when the pair was
     /// matched through the scans between its two (see [`crate::chained`]).
     pub links: u32,
+    /// Scans besides the pair's own two that the pair was matched with: its scans
+    /// densified by their neighbours (see [`crate::local_map`]); 0 for a match of
+    /// the two scans alone.
+    pub neighbours: u32,
+}
+
+impl MatchStats {
+    /// One match of a pair's own two scans: `result`'s pose, covariance and
+    /// statistics.
+    pub(crate) fn of(result: &odocal_icp::IcpResult) -> MatchStats {
+        MatchStats {
+            pose: result.pose,
+            covariance: result.covariance,
+            iterations: result.iterations,
+            correspondences: result.correspondences,
+            mean_residual: result.mean_residual,
+            links: 1,
+            neighbours: 0,
+        }
+    }
 }
 
 /// Scans sampled to estimate the log's typical range noise.
@@ -71,6 +91,23 @@ pub fn scan_returns(scans: &ScanStore) -> Option<ScanReturns> {
     })
 }
 
+/// Scan `i` of `scans` prepared for matching with `params`; `None` when the store has
+/// no scan `i`.
+pub(crate) fn prepare_scan(
+    scans: &ScanStore,
+    i: usize,
+    params: &IcpParams,
+) -> Option<Result<PreparedScan, odocal_icp::IcpError>> {
+    let s = scans.get(i)?;
+    Some(PreparedScan::new(
+        s.ranges,
+        &s.geometry.angles,
+        s.geometry.min_range,
+        s.geometry.max_range,
+        params,
+    ))
+}
+
 /// The median range noise (σ, m) of up to [`NOISE_SAMPLE_SCANS`] scans spread evenly
 /// over the store, among those whose noise shows (straight stretches); 0 when none
 /// does. What the matcher's consistency test assumes for scans too cluttered or
@@ -81,18 +118,7 @@ pub fn typical_noise_sigma(scans: &ScanStore, params: &IcpParams) -> f64 {
     // On the current pool's threads; collected in scan order.
     let mut noise: Vec<f64> = sampled
         .into_par_iter()
-        .filter_map(|i| {
-            let s = scans.get(i)?;
-            PreparedScan::new(
-                s.ranges,
-                &s.geometry.angles,
-                s.geometry.min_range,
-                s.geometry.max_range,
-                params,
-            )
-            .ok()?
-            .noise_sigma()
-        })
+        .filter_map(|i| prepare_scan(scans, i, params)?.ok()?.noise_sigma())
         .collect();
     if noise.is_empty() {
         return 0.0;
@@ -187,14 +213,7 @@ pub fn match_pairs(
                     "the scans do not constrain the displacement (ill-conditioned)",
                 ));
             }
-            Ok(MatchStats {
-                pose: r.pose,
-                covariance: r.covariance,
-                iterations: r.iterations,
-                correspondences: r.correspondences,
-                mean_residual: r.mean_residual,
-                links: 1,
-            })
+            Ok(MatchStats::of(&r))
         },
         done,
     )

@@ -5,6 +5,7 @@ use crate::consistency::{check_halves, Consistency};
 use crate::error::PipelineError;
 use crate::finding::{Finding, FindingKind};
 use crate::health;
+use crate::local_map::rescue_with_neighbours;
 use crate::matching::{match_pairs, typical_noise_sigma, with_typical_noise, MatchStats};
 use crate::options::{Options, BOOTSTRAP_PAIRS, BOOTSTRAP_RUN, MIN_SAMPLES};
 use crate::progress::Progress;
@@ -19,6 +20,7 @@ use crate::sync::{
 use crate::synchronized::Synchronized;
 use crate::time_offset::{estimate_time_offset, OffsetEstimate};
 use odocal_geom::Pose2;
+use odocal_icp::IcpParams;
 use odocal_log::{Log, ScanStore};
 use odocal_solver::{Calibration, Constraint, Params, Predictor, SolveOptions, Verdict};
 use std::borrow::Cow;
@@ -288,7 +290,7 @@ pub fn synchronize_and_match(
         use_profile: opts.use_profile,
         time_offset: opts.time_offset,
     };
-    rescue_refused(
+    rescue(
         &links,
         &mut scans,
         sweep_compensated,
@@ -336,6 +338,21 @@ pub fn synchronize_and_match(
         unmodelled_slide: None,
         scan_returns: crate::matching::scan_returns(&log.scans),
     })
+}
+
+/// The pairs refused in `results`, matched again: through the scans between their
+/// two ([`crate::chained`]), then, those of sparse scans still refused, with their
+/// neighbouring scans ([`crate::local_map`]).
+fn rescue(
+    links: &LinkSource<'_>,
+    scans: &mut Cow<'_, ScanStore>,
+    compensated: bool,
+    pairs: &[(usize, usize)],
+    results: &mut [Result<MatchStats, MatchFailure>],
+    icp: &IcpParams,
+) {
+    rescue_refused(links, scans, compensated, pairs, results, icp);
+    rescue_with_neighbours(links, scans, compensated, pairs, results, icp);
 }
 
 /// Matches the samples again with first guesses from `params` — and, when the scans
@@ -391,7 +408,7 @@ fn second_pass(
         use_profile: opts.use_profile,
         time_offset: synced.time_offset,
     };
-    rescue_refused(&links, &mut scans, sweep, &index_pairs, &mut matched, &icp);
+    rescue(&links, &mut scans, sweep, &index_pairs, &mut matched, &icp);
     progress.finish();
     let old = std::mem::take(&mut synced.samples);
     for ((s, m), covered) in old.into_iter().zip(matched).zip(covered) {
@@ -662,8 +679,27 @@ pub fn calibrate_log(
         // This estimate only gives the second pass its first guesses and, with a
         // sweep, compensates the sweep again at the offset now used: the verdicts are
         // those of the final solve.
-        let first =
-            solve(&synced, &lenient).map_err(|e| PipelineError::with_faults(e, &findings))?;
+        // Without the pairs matched with their neighbouring scans where enough are
+        // left: those were placed by odometry with the first guesses' estimate, and
+        // an estimate made with them would pull the second pass's placements toward
+        // those guesses (crate::local_map).
+        let own = synced
+            .samples
+            .iter()
+            .any(|s| s.icp.neighbours > 0)
+            .then(|| Synchronized {
+                samples: synced
+                    .samples
+                    .iter()
+                    .filter(|s| s.icp.neighbours == 0)
+                    .cloned()
+                    .collect(),
+                ..synced.clone()
+            });
+        let first = match own.as_ref().map(|own| solve(own, &lenient)) {
+            Some(Ok(first)) => first,
+            _ => solve(&synced, &lenient).map_err(|e| PipelineError::with_faults(e, &findings))?,
+        };
         timing.solve += t_solve.elapsed().as_secs_f64();
         let t = Instant::now();
         second_pass(log, &mut synced, &first.params, opts, progress);

@@ -51,7 +51,8 @@ impl PairSample {
     /// scan timestamps `t0`, `t1` (laser clock), ŝ's covariance, the encoder profile and
     /// the ICP statistics (`icp_iterations`, `icp_correspondences`,
     /// `icp_mean_residual`, `scan0`, `scan1`; `icp_links` when ŝ was composed of several
-    /// matches).
+    /// matches, `icp_neighbours` when the pair's scans were densified by their
+    /// neighbours).
     pub fn to_tuple(&self) -> TupleRecord {
         let w = &self.wheel;
         let mut rec = TupleRecord::new(
@@ -81,6 +82,11 @@ impl PairSample {
         if self.icp.links > 1 {
             // Matched through the scans between the pair's two (crate::chained).
             extra.insert("icp_links".into(), self.icp.links.into());
+        }
+        if self.icp.neighbours > 0 {
+            // Matched with the pair's scans densified by their neighbours
+            // (crate::local_map).
+            extra.insert("icp_neighbours".into(), self.icp.neighbours.into());
         }
         rec
     }
@@ -180,6 +186,7 @@ mod tests {
                 correspondences: 600 + k % 50,
                 mean_residual: 1e-3 / (1.0 + x),
                 links: 1,
+                neighbours: 0,
             },
         }
     }

@@ -55,6 +55,10 @@ pub struct Report {
     /// their two instead (a chain of 2 to 4 shorter matches; see
     /// `odocal_pipeline::chained`), among the samples synchronized.
     pub chained_matches: usize,
+    /// Pairs of sparse scans refused when matched alone and matched with each scan
+    /// densified by the scans beyond it, placed by odometry (see
+    /// `odocal_pipeline::local_map`), among the samples synchronized.
+    pub neighbour_matches: usize,
     /// The scan matcher's own error per pair, measured on this log by the closure of
     /// scan triples; absent when too few triples close.
     pub match_self_check: Option<MatchSelfCheck>,
@@ -246,6 +250,12 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             .samples
             .iter()
             .filter(|s| s.icp.links > 1)
+            .count(),
+        neighbour_matches: outcome
+            .synced
+            .samples
+            .iter()
+            .filter(|s| s.icp.neighbours > 0)
             .count(),
         match_self_check: outcome.synced.match_self_check,
         stride: e.stride,
@@ -441,6 +451,14 @@ impl fmt::Display for Report {
                 f,
                 "  matched through the scans between: {} pairs refused when matched directly (ŝ composed of 2 to 4 shorter matches)",
                 self.chained_matches
+            )?;
+        }
+        if self.neighbour_matches > 0 {
+            writeln!(
+                f,
+                "  matched with their neighbouring scans: {} pairs of sparse scans refused when matched alone (each scan densified by the {} scans beyond it, placed by odometry)",
+                self.neighbour_matches,
+                odocal_pipeline::local_map::NEIGHBOURS
             )?;
         }
         if let Some(c) = &self.match_self_check {

@@ -308,6 +308,7 @@ mod tests {
                         correspondences: 100,
                         mean_residual: 0.0,
                         links: 1,
+                        neighbours: 0,
                     },
                 }
             })

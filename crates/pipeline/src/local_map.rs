@@ -1,0 +1,191 @@
+//! Pairs of sparse scans the matcher refused, matched again with each scan densified
+//! by its neighbouring scans.
+//!
+//! A 1° LDS that returns 40–80 points of 361 (the Neato's) gives scans whose points on
+//! a wall lie 10–30 cm apart: too few lie near each other for lines, and the pairwise
+//! match of such a scan is refused (too few correspondences, too little of the scan
+//! explained). The scans just before and just after see the same walls at other rays.
+//! So a refused pair `(a, b)` of sparse scans is matched again as two point clouds:
+//! scan `a` with the [`NEIGHBOURS`] scan before it placed in its frame, and scan `b`
+//! with the one after it placed in its frame. The scans between the two are left
+//! out, so that no scan is in both clouds and no odometry over the pair's own
+//! interval enters its match. The neighbours are placed by odometry with the current
+//! estimate over one scan period; the pair keeps its own interval and its own wheel
+//! motion.
+//!
+//! What this costs in honesty: the placement carries the odometry's error over that
+//! period, which the match's covariance does not hold, and it pulls the match toward
+//! the estimate the placement used. So the estimate that gives the second pass its
+//! guesses and placements is solved without these pairs (`run::calibrate_log`): with
+//! the nominal radii 3 % off either way, the Neato's calibrated radii then move as
+//! they do without the stage. Measured in docs/benchmarks.md, stop 37.
+//!
+//! Only pairs with a sparse scan (see [`odocal_icp::PreparedScan::is_sparse`]) are
+//! tried, and only for refusals more points cure ([`worth_densifying`]); a pair whose
+//! own scans cannot be prepared is left refused.
+
+use crate::chained::LinkSource;
+use crate::matching::{prepare_scan, MatchStats};
+use crate::rejection::{MatchFailure, Rejection};
+use crate::sweep::compensate_into;
+use odocal_icp::{IcpParams, Matcher, PreparedScan};
+use odocal_log::ScanStore;
+use odocal_solver::Predictor;
+use rayon::prelude::*;
+use std::borrow::Cow;
+use std::collections::{BTreeSet, HashMap};
+
+/// Scans merged into each scan of a refused pair: the one before the first scan, the
+/// one after the second (one scan period of odometry each). Two each matched 2 % more
+/// of the simulated Neato's pairs, but on the real MinesRover logs thinned to a
+/// Neato-like scan (a skid-steer that slips in turns) they agreed worse with the
+/// full logs than one each, and than without the stage (docs/benchmarks.md, stop 37).
+pub const NEIGHBOURS: usize = 1;
+
+/// Whether a pair of sparse scans refused for `failure` is worth matching with its
+/// neighbouring scans: refusals for too few points in common (too few
+/// correspondences, too small a share of the current scan explained), which more
+/// points cure. Not an unusable scan, nor a displacement the walls do not constrain
+/// (a corridor stays one with more points along it: of the Neato's pairs refused as
+/// ill-conditioned, 17 % were matched with their neighbours, at the cost of a full
+/// correlative search each), nor ambiguity or iterations that did not settle (4 of
+/// 45).
+pub fn worth_densifying(failure: &MatchFailure) -> bool {
+    matches!(
+        failure.reason,
+        Rejection::Correspondences | Rejection::Overlap
+    )
+}
+
+/// The scans `indices` of `scans`, each prepared once (in parallel), by index.
+fn prepare_all(
+    scans: &ScanStore,
+    indices: impl Iterator<Item = usize>,
+    params: &IcpParams,
+) -> HashMap<usize, PreparedScan> {
+    let unique: BTreeSet<usize> = indices.collect();
+    let unique: Vec<usize> = unique.into_iter().collect();
+    unique
+        .par_iter()
+        .filter_map(|&i| Some((i, prepare_scan(scans, i, params)?.ok()?)))
+        .collect::<Vec<_>>()
+        .into_iter()
+        .collect()
+}
+
+/// The points of scan `anchor` and of those of `neighbours` odometry can place in its
+/// frame, and how many those are; `None` when the anchor is unusable or the cloud
+/// cannot be prepared.
+fn cloud(
+    source: &LinkSource<'_>,
+    predictor: &Predictor,
+    prepared: &HashMap<usize, PreparedScan>,
+    anchor: usize,
+    neighbours: impl Iterator<Item = usize>,
+    params: &IcpParams,
+) -> Option<(PreparedScan, u32)> {
+    let mut points = prepared.get(&anchor)?.points().to_vec();
+    let mut placed = 0;
+    for n in neighbours {
+        let (Some(scan), Some(pose)) = (prepared.get(&n), source.odometry(predictor, anchor, n))
+        else {
+            continue;
+        };
+        points.extend(scan.points().iter().map(|p| pose.transform_point(*p)));
+        placed += 1;
+    }
+    Some((PreparedScan::from_points(&points, params).ok()?, placed))
+}
+
+/// Matches the pairs refused in `results` (one per pair of `pairs`) whose scans are
+/// sparse again as clouds of their scans and neighbours (see the module
+/// documentation), and replaces each one accepted (its `neighbours` above 0 say so).
+/// `scans` are the scans the pairs were matched on: with `compensated` (swept scans
+/// compensated with `source.params`) the neighbours are compensated into them
+/// first. Without an estimate (`source.params`) nothing is placed, so nothing is
+/// tried.
+pub fn rescue_with_neighbours(
+    source: &LinkSource<'_>,
+    scans: &mut Cow<'_, ScanStore>,
+    compensated: bool,
+    pairs: &[(usize, usize)],
+    results: &mut [Result<MatchStats, MatchFailure>],
+    params: &IcpParams,
+) {
+    let Some(estimate) = source.params else {
+        return;
+    };
+    let refused: Vec<usize> = (0..pairs.len())
+        .filter(|&k| matches!(&results[k], Err(f) if worth_densifying(f)))
+        .collect();
+    if refused.is_empty() {
+        return;
+    }
+    // The pairs' own scans (compensated already when the sweep is): is one sparse?
+    let own = prepare_all(
+        scans,
+        refused.iter().flat_map(|&k| [pairs[k].0, pairs[k].1]),
+        params,
+    );
+    let sparse = |i: usize| own.get(&i).is_some_and(|s| s.is_sparse(params));
+    let refused: Vec<usize> = refused
+        .into_iter()
+        .filter(|&k| sparse(pairs[k].0) || sparse(pairs[k].1))
+        .collect();
+    if refused.is_empty() {
+        return;
+    }
+    let count = source.scans.len();
+    let reference_side = |a: usize| a.saturating_sub(NEIGHBOURS)..a;
+    let current_side = move |b: usize| (b + 1)..(b + 1 + NEIGHBOURS).min(count);
+    let neighbours: BTreeSet<usize> = refused
+        .iter()
+        .flat_map(|&k| reference_side(pairs[k].0).chain(current_side(pairs[k].1)))
+        .filter(|n| !own.contains_key(n))
+        .collect();
+    if compensated {
+        let out = scans.to_mut();
+        for &n in &neighbours {
+            // A neighbour whose sweep the counts do not cover stays as read, and is
+            // not placed (its odometry is not covered either).
+            compensate_into(
+                out,
+                source.scans,
+                n,
+                source.track,
+                source.limits,
+                estimate,
+                source.time_offset,
+            );
+        }
+    }
+    let mut prepared = prepare_all(scans, neighbours.into_iter(), params);
+    prepared.extend(own);
+    let predictor = Predictor::new(estimate, source.use_profile);
+    let rescued: Vec<Option<MatchStats>> = refused
+        .par_iter()
+        .map(|&k| {
+            let (a, b) = pairs[k];
+            let (reference, before) =
+                cloud(source, &predictor, &prepared, a, reference_side(a), params)?;
+            let (current, after) =
+                cloud(source, &predictor, &prepared, b, current_side(b), params)?;
+            if before + after == 0 {
+                return None;
+            }
+            let guess = source.guess(Some(&predictor), a, b);
+            let r = Matcher::new(params.clone())
+                .match_scans(&reference, &current, guess)
+                .ok()?;
+            (!r.ill_conditioned).then(|| MatchStats {
+                neighbours: before + after,
+                ..MatchStats::of(&r)
+            })
+        })
+        .collect();
+    for (k, m) in refused.into_iter().zip(rescued) {
+        if let Some(m) = m {
+            results[k] = Ok(m);
+        }
+    }
+}
