@@ -97,9 +97,9 @@ fn cloud(
     Some((PreparedScan::from_points(&points, params).ok()?, placed))
 }
 
-/// Matches the pairs refused in `results` (one per pair of `pairs`) whose scans are
-/// sparse again as clouds of their scans and neighbours (see the module
-/// documentation), and replaces each one accepted (its `neighbours` above 0 say so).
+/// Matches the pairs refused in `results` (one per pair of `pairs`) with a sparse scan
+/// again as clouds of their scans and neighbours (see the module documentation), and
+/// replaces each one accepted (its `neighbours` above 0 say so).
 /// `scans` are the scans the pairs were matched on: with `compensated` (swept scans
 /// compensated with `source.params`) the neighbours are compensated into them
 /// first. Without an estimate (`source.params`) nothing is placed, so nothing is
@@ -138,16 +138,16 @@ pub fn rescue_with_neighbours(
     let count = source.scans.len();
     let reference_side = |a: usize| a.saturating_sub(NEIGHBOURS)..a;
     let current_side = move |b: usize| (b + 1)..(b + 1 + NEIGHBOURS).min(count);
-    let neighbours: BTreeSet<usize> = refused
+    let mut neighbours: BTreeSet<usize> = refused
         .iter()
         .flat_map(|&k| reference_side(pairs[k].0).chain(current_side(pairs[k].1)))
         .filter(|n| !own.contains_key(n))
         .collect();
     if compensated {
         let out = scans.to_mut();
-        for &n in &neighbours {
-            // A neighbour whose sweep the counts do not cover stays as read, and is
-            // not placed (its odometry is not covered either).
+        // A neighbour whose sweep the counts do not cover is left out: as read, its
+        // points would be distorted by the sweep the others are compensated for.
+        neighbours.retain(|&n| {
             compensate_into(
                 out,
                 source.scans,
@@ -156,8 +156,8 @@ pub fn rescue_with_neighbours(
                 source.limits,
                 estimate,
                 source.time_offset,
-            );
-        }
+            )
+        });
     }
     let mut prepared = prepare_all(scans, neighbours.into_iter(), params);
     prepared.extend(own);
