@@ -299,6 +299,61 @@ mod tests {
         }
     }
 
+    /// Odometry between scans, as the neighbouring-scan clouds place them
+    /// ([`crate::local_map`]): backward in time it is the inverse of forward, over
+    /// two periods the composition of the two, and the identity where the wheels
+    /// stood still.
+    #[test]
+    fn odometry_between_scans_either_way() {
+        use odocal_log::EncoderRecord;
+        // Left wheel 10 ticks every 10 ms, right 14: a constant arc; still after 0.5 s.
+        let encoders: Vec<EncoderRecord> = (0..=100)
+            .map(|k| {
+                let moving = k.min(50);
+                EncoderRecord {
+                    t: k as f64 * 0.01,
+                    left: 10 * moving,
+                    right: 14 * moving,
+                    line: 0,
+                }
+            })
+            .collect();
+        let track = EncoderTrack::new(&encoders, 4096.0);
+        let scan_times = [0.1, 0.2, 0.3, 0.6, 0.7];
+        let limits = SyncLimits {
+            max_encoder_gap: 0.05,
+            still_ticks: 1.0,
+            max_interval: 1.0,
+        };
+        let params = Params {
+            r_l: 0.03,
+            r_r: 0.03,
+            b: 0.2,
+            laser: Pose2::new(0.1, 0.02, 0.05),
+        };
+        let source = LinkSource {
+            scans: &ScanStore::default(),
+            scan_times: &scan_times,
+            track: &track,
+            limits: &limits,
+            params: Some(&params),
+            use_profile: true,
+            time_offset: 0.0,
+        };
+        let predictor = Predictor::new(&params, true);
+        let forward = source.odometry(&predictor, 0, 1).unwrap();
+        let backward = source.odometry(&predictor, 1, 0).unwrap();
+        let e = forward.compose(&backward);
+        assert!(forward.translation_norm() > 1e-3, "{forward}");
+        assert!(e.translation_norm() < 1e-12 && e.theta.abs() < 1e-12, "{e}");
+        let two = source.odometry(&predictor, 0, 2).unwrap();
+        let chained = forward.compose(&source.odometry(&predictor, 1, 2).unwrap());
+        let e = two.between(&chained);
+        assert!(e.translation_norm() < 1e-9 && e.theta.abs() < 1e-9, "{e}");
+        assert_eq!(source.odometry(&predictor, 3, 4), Some(Pose2::IDENTITY));
+        assert_eq!(source.odometry(&predictor, 0, 9), None);
+    }
+
     #[test]
     fn halves_split_at_the_middle_scan_down_to_neighbours() {
         let [a, b] = halves(10, 14).expect("four apart");
