@@ -108,3 +108,4 @@ pub use error::IcpError;
 pub use matcher::{IcpResult, Matcher};
 pub use params::{IcpParams, NeighbourSearch};
 pub use preprocess::PreparedScan;
+pub use sparse_fallback::coarse_rays;

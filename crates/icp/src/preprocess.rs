@@ -433,7 +433,7 @@ fn kept_readings(ranges: &[f32], lo: f64, hi: f64, bridged: usize) -> (Vec<u32>,
 }
 
 /// Mean angle between neighbouring rays (rad; 0 for fewer than two).
-fn mean_step(angles: &[f64]) -> f64 {
+pub(crate) fn mean_step(angles: &[f64]) -> f64 {
     match (angles.first(), angles.last()) {
         (Some(a), Some(b)) if angles.len() > 1 => (b - a).abs() / (angles.len() - 1) as f64,
         _ => 0.0,

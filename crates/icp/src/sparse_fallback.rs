@@ -113,6 +113,13 @@ pub(crate) fn applies(
     (sparse(reference) || sparse(current)) && searchable(reference) && searchable(current)
 }
 
+/// Are rays at `angles` (rad, in scan order) far enough apart (0.7° on average) for a
+/// scan of them to be sparse ([`PreparedScan::is_sparse`])? A scan with closer rays
+/// never is, whatever its returns: the cheap test before preparing it.
+pub fn coarse_rays(angles: &[f64]) -> bool {
+    crate::preprocess::mean_step(angles) >= COARSE_RAY_STEP
+}
+
 /// The scan's rays are coarse and it has few returns per turn (see [`applies`]).
 pub(crate) fn sparse_scan(scan: &PreparedScan, params: &IcpParams) -> bool {
     scan.ray_step >= COARSE_RAY_STEP

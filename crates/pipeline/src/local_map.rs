@@ -115,8 +115,16 @@ pub fn rescue_with_neighbours(
     let Some(estimate) = source.params else {
         return;
     };
+    // Rays closer than the sparse matcher's (every laser but a 1° LDS): no scan of
+    // the pair can be sparse, and none is prepared to find out.
+    let coarse = |i: usize| {
+        scans
+            .get(i)
+            .is_some_and(|s| odocal_icp::coarse_rays(&s.geometry.angles))
+    };
     let refused: Vec<usize> = (0..pairs.len())
         .filter(|&k| matches!(&results[k], Err(f) if worth_densifying(f)))
+        .filter(|&k| coarse(pairs[k].0) || coarse(pairs[k].1))
         .collect();
     if refused.is_empty() {
         return;

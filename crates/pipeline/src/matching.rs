@@ -176,20 +176,15 @@ pub fn match_pairs(
         own_params = with_typical_noise(params, typical_noise_sigma(scans, params));
         params = &own_params;
     }
-    let prepare = |i: usize| match scans.get(i) {
-        Some(s) => PreparedScan::new(
-            s.ranges,
-            &s.geometry.angles,
-            s.geometry.min_range,
-            s.geometry.max_range,
-            params,
-        )
-        .map_err(|e| {
-            MatchFailure::new(
+    let prepare = |i: usize| match prepare_scan(scans, i, params) {
+        Some(Ok(scan)) => Ok(scan),
+        Some(Err(e)) => {
+            let place = scans.get(i).map(|s| scan_place(&s)).unwrap_or_default();
+            Err(MatchFailure::new(
                 Rejection::of(&e),
-                format!("scan {i} ({}): {e}", scan_place(&s)),
-            )
-        }),
+                format!("scan {i} ({place}): {e}"),
+            ))
+        }
         None => Err(MatchFailure::new(
             Rejection::Scan,
             format!("scan {i} does not exist"),

@@ -687,14 +687,10 @@ pub fn calibrate_log(
             .samples
             .iter()
             .any(|s| s.icp.neighbours > 0)
-            .then(|| Synchronized {
-                samples: synced
-                    .samples
-                    .iter()
-                    .filter(|s| s.icp.neighbours == 0)
-                    .cloned()
-                    .collect(),
-                ..synced.clone()
+            .then(|| {
+                let mut own = synced.clone();
+                own.samples.retain(|s| s.icp.neighbours == 0);
+                own
             });
         let first = match own.as_ref().map(|own| solve(own, &lenient)) {
             Some(Ok(first)) => first,
