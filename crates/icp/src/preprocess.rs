@@ -111,6 +111,10 @@ pub struct PreparedScan {
     /// not one scan's rays: matched by the sparse matcher, whose lines come from
     /// metric neighbourhoods, never from consecutive rays.
     pub(crate) cloud: bool,
+    /// Per reading of a cloud: placed from a neighbouring scan, not the anchor scan's
+    /// own (empty for a scan). Placed points help the fit; the share of the current
+    /// scan a match explains is taken over the own ones.
+    pub(crate) placed: Vec<bool>,
 }
 
 /// Window statistics of a local line fit.
@@ -272,31 +276,58 @@ impl PreparedScan {
             noise_sigma,
             tree,
             cloud: false,
+            placed: Vec::new(),
         })
     }
 
-    /// Prepares a point cloud (m, in one sensor frame): the points of a scan and of
-    /// its neighbours placed in its frame, which a pair of sparse scans too poor to
-    /// match alone is matched with. Pairs with a cloud are matched by the sparse
-    /// matcher (lines through metric neighbourhoods of the points; see the crate
-    /// documentation) when the clouds hold at most 2,048 points each; the order of the
-    /// points does not matter (they are taken by bearing).
+    /// Prepares a point cloud (m, in one sensor frame): the points `own` of a scan and
+    /// the points `placed` of its neighbours placed in its frame, which a pair of
+    /// sparse scans too poor to match alone is matched with. Pairs with a cloud are
+    /// matched by the sparse matcher (lines through metric neighbourhoods of the
+    /// points; see the crate documentation) when the clouds hold at most 2,048 points
+    /// each; the order of the points does not matter (they are taken by bearing).
+    /// Both kinds enter the fit; the share of the current cloud a match must explain
+    /// ([`IcpParams::min_matched_share`]) is taken over its `own` points: the pair's
+    /// overlap is its two scans', and a neighbour's points beyond what the other
+    /// cloud saw are no evidence against the match.
     ///
     /// Errors: fewer than `params.min_valid_points` finite points within
     /// `params.min_reading` and `params.max_reading` of the origin, or invalid
     /// parameters.
-    pub fn from_points(points: &[[f64; 2]], params: &IcpParams) -> Result<PreparedScan, IcpError> {
-        let mut polar: Vec<(f64, f32)> = points
-            .iter()
-            .filter(|p| p[0].is_finite() && p[1].is_finite())
-            .map(|p| (p[1].atan2(p[0]), (p[0] * p[0] + p[1] * p[1]).sqrt() as f32))
-            .collect();
+    pub fn from_points(
+        own: &[[f64; 2]],
+        placed: &[[f64; 2]],
+        params: &IcpParams,
+    ) -> Result<PreparedScan, IcpError> {
+        let tagged = |points: &'_ [[f64; 2]], placed: bool| {
+            points
+                .iter()
+                .filter(|p| p[0].is_finite() && p[1].is_finite())
+                .map(move |p| {
+                    let range = (p[0] * p[0] + p[1] * p[1]).sqrt() as f32;
+                    (p[1].atan2(p[0]), range, placed)
+                })
+                .collect::<Vec<_>>()
+        };
+        let mut polar = tagged(own, false);
+        polar.extend(tagged(placed, true));
         polar.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
         let angles: Vec<f64> = polar.iter().map(|p| p.0).collect();
         let ranges: Vec<f32> = polar.iter().map(|p| p.1).collect();
         let mut cloud = PreparedScan::new(&ranges, &angles, 0.0, f64::INFINITY, params)?;
         cloud.cloud = true;
+        cloud.placed = polar.iter().map(|p| p.2).collect();
         Ok(cloud)
+    }
+
+    /// Is the kept point `k` of a cloud placed from a neighbouring scan (see
+    /// [`PreparedScan::from_points`])? Never for a scan.
+    pub(crate) fn is_placed(&self, k: usize) -> bool {
+        self.original
+            .get(k)
+            .and_then(|&i| self.placed.get(i as usize))
+            .copied()
+            .unwrap_or(false)
     }
 
     /// Would a pair with this scan be matched by the sparse matcher (coarse rays and

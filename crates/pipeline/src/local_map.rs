@@ -11,7 +11,8 @@
 //! out, so that no scan is in both clouds and no odometry over the pair's own
 //! interval enters its match. The neighbours are placed by odometry with the current
 //! estimate over one scan period; the pair keeps its own interval and its own wheel
-//! motion.
+//! motion. The match must explain a share of the second scan's own points, not of
+//! its neighbour's ([`PreparedScan::from_points`]).
 //!
 //! What this costs in honesty: the placement carries the odometry's error over that
 //! period, which the match's covariance does not hold, and it pulls the match toward
@@ -84,7 +85,8 @@ fn cloud(
     neighbours: impl Iterator<Item = usize>,
     params: &IcpParams,
 ) -> Option<(PreparedScan, u32)> {
-    let mut points = prepared.get(&anchor)?.points().to_vec();
+    let own = prepared.get(&anchor)?.points();
+    let mut points = Vec::new();
     let mut placed = 0;
     for n in neighbours {
         let (Some(scan), Some(pose)) = (prepared.get(&n), source.odometry(predictor, anchor, n))
@@ -94,7 +96,10 @@ fn cloud(
         points.extend(scan.points().iter().map(|p| pose.transform_point(*p)));
         placed += 1;
     }
-    Some((PreparedScan::from_points(&points, params).ok()?, placed))
+    Some((
+        PreparedScan::from_points(own, &points, params).ok()?,
+        placed,
+    ))
 }
 
 /// Matches the pairs refused in `results` (one per pair of `pairs`) with a sparse scan
