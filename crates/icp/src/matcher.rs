@@ -69,6 +69,8 @@ pub struct IcpResult {
     /// [`IcpParams::min_matched_share`], per such point the reference could have
     /// matched: its nearest reference point within the correspondence gate has a
     /// local line, or it has none within the gate (free space counts against a match).
+    /// For a point cloud, over its own scan's points only
+    /// ([`crate::PreparedScan::from_points`]).
     pub matched_share: f64,
     /// Starting points tried: 1 when the first guess led to the result.
     pub starts: u32,
