@@ -756,3 +756,64 @@ fn sparse_pairs_refused_alone_are_matched_with_their_neighbouring_scans() {
         "{wrong} of them beyond 5 mm / 0.5°, their covariances predict {predicted:.1}"
     );
 }
+
+/// The pairs matched with their neighbouring scans are reported alike in the
+/// summary, `results.json` (`neighbour_matches`) and the tuples (`icp_neighbours`),
+/// and the summary says how many scans densified each one.
+#[test]
+fn pairs_matched_with_their_neighbouring_scans_are_reported_in_every_output() {
+    let odocal = env!("CARGO_BIN_EXE_odocal");
+    let dir = std::env::temp_dir().join(format!("odocal-neighbours-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let prefix = dir.join("neato");
+    let run = |args: &[&str], path: &std::path::Path| {
+        let out = std::process::Command::new(odocal)
+            .args(args)
+            .arg(path)
+            .output()
+            .expect("run odocal");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    let simulate = [
+        "simulate",
+        "--preset",
+        "neato-lds",
+        "--seed",
+        "5",
+        "--duration",
+        "20",
+        "--out",
+    ];
+    run(&simulate, &prefix);
+    let out = dir.join("out");
+    let log = prefix.with_extension("log");
+    let summary = run(
+        &["calibrate", "--accept-weak", "--out", out.to_str().unwrap()],
+        &log,
+    );
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let n = results["neighbour_matches"].as_u64().unwrap();
+    assert!(n > 0, "{summary}");
+    let tuples = std::fs::read_to_string(out.join("samples.tuple")).unwrap();
+    let in_tuples = tuples
+        .lines()
+        .filter(|l| {
+            let t: serde_json::Value = serde_json::from_str(l).unwrap();
+            t["icp_neighbours"].as_u64().unwrap_or(0) > 0
+        })
+        .count() as u64;
+    assert_eq!(in_tuples, n);
+    let line = format!("matched with their neighbouring scans: {n} pairs");
+    assert!(summary.contains(&line), "{summary}");
+    assert!(
+        summary.contains("densified by the scan beyond it"),
+        "{summary}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

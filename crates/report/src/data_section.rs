@@ -30,7 +30,7 @@ pub(crate) const ROWS: [Row; 26] = [
     Row { key: "discarded", label: "Pairs discarded, by cause", meaning: "pairs not used: a gap in the wheel data, too long between the scans, a failed match, the robot standing still" },
     Row { key: "match_rejections", label: "Failed matches, by reason", meaning: "why the scan matcher refused the pairs it could not match" },
     Row { key: "chained_matches", label: "Pairs matched through the scans between", meaning: "pairs refused when matched directly and matched as a chain of shorter matches (2 to 4) through the scans between their two; ŝ is the chain's composition" },
-    Row { key: "neighbour_matches", label: "Pairs matched with their neighbouring scans", meaning: "pairs of sparse scans refused when matched alone and matched with each scan densified by the two scans beyond it, placed by odometry" },
+    Row { key: "neighbour_matches", label: "Pairs matched with their neighbouring scans", meaning: "pairs of sparse scans refused when matched alone and matched with each scan densified by the scan beyond it (the one before the first, the one after the second), placed by odometry" },
     Row { key: "match_self_check", label: "Scan-matching self-check", meaning: "the matcher's own error, from the closure of consecutive scan triples (a lower bound)" },
     Row { key: "stride", label: "Stride", meaning: "scans from the first to the second scan of a pair" },
     Row { key: "interval_s", label: "Pair interval", meaning: "target time (s) between the two scans of a pair" },

@@ -56,7 +56,7 @@ pub struct Report {
     /// `odocal_pipeline::chained`), among the samples synchronized.
     pub chained_matches: usize,
     /// Pairs of sparse scans refused when matched alone and matched with each scan
-    /// densified by the scans beyond it, placed by odometry (see
+    /// densified by the scan beyond it, placed by odometry (see
     /// `odocal_pipeline::local_map`), among the samples synchronized.
     pub neighbour_matches: usize,
     /// The scan matcher's own error per pair, measured on this log by the closure of
@@ -456,9 +456,12 @@ impl fmt::Display for Report {
         if self.neighbour_matches > 0 {
             writeln!(
                 f,
-                "  matched with their neighbouring scans: {} pairs of sparse scans refused when matched alone (each scan densified by the {} scans beyond it, placed by odometry)",
+                "  matched with their neighbouring scans: {} pairs of sparse scans refused when matched alone (each scan densified by {} beyond it, placed by odometry)",
                 self.neighbour_matches,
-                odocal_pipeline::local_map::NEIGHBOURS
+                match odocal_pipeline::local_map::NEIGHBOURS {
+                    1 => "the scan".to_string(),
+                    n => format!("the {n} scans"),
+                }
             )?;
         }
         if let Some(c) = &self.match_self_check {
