@@ -7,6 +7,8 @@
 //! The table, on longer logs and several seeds:
 //! `cargo test --release --test realistic_matching -- --ignored --nocapture`.
 
+mod common;
+
 use odocal_geom::Pose2;
 use odocal_pipeline::{synchronize_and_match, NoProgress, Options, Timing};
 use odocal_sim::{simulate_in, RealisticLaser, SimConfig, SimRun, World, REALISTIC_PRESETS};
@@ -762,24 +764,16 @@ fn sparse_pairs_refused_alone_are_matched_with_their_neighbouring_scans() {
 /// and the summary says how many scans densified each one.
 #[test]
 fn pairs_matched_with_their_neighbouring_scans_are_reported_in_every_output() {
-    let odocal = env!("CARGO_BIN_EXE_odocal");
-    let dir = std::env::temp_dir().join(format!("odocal-neighbours-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let dir = common::temp_dir("neighbours");
     let prefix = dir.join("neato");
-    let run = |args: &[&str], path: &std::path::Path| {
-        let out = std::process::Command::new(odocal)
-            .args(args)
-            .arg(path)
-            .output()
-            .expect("run odocal");
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8_lossy(&out.stdout).into_owned()
+    let out = dir.join("out");
+    let log = prefix.with_extension("log");
+    let run = |args: &[&str]| {
+        let o = common::odocal(args);
+        assert!(o.status.success(), "{}", common::stderr(&o));
+        String::from_utf8_lossy(&o.stdout).into_owned()
     };
-    let simulate = [
+    run(&[
         "simulate",
         "--preset",
         "neato-lds",
@@ -788,14 +782,15 @@ fn pairs_matched_with_their_neighbouring_scans_are_reported_in_every_output() {
         "--duration",
         "20",
         "--out",
-    ];
-    run(&simulate, &prefix);
-    let out = dir.join("out");
-    let log = prefix.with_extension("log");
-    let summary = run(
-        &["calibrate", "--accept-weak", "--out", out.to_str().unwrap()],
-        &log,
-    );
+        prefix.to_str().unwrap(),
+    ]);
+    let summary = run(&[
+        "calibrate",
+        "--accept-weak",
+        "--out",
+        out.to_str().unwrap(),
+        log.to_str().unwrap(),
+    ]);
     let results: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
     let n = results["neighbour_matches"].as_u64().unwrap();

@@ -166,6 +166,9 @@ struct Pair<'a> {
     current: Vec<[f64; 2]>,
     current_rays: Vec<usize>,
     current_scan: &'a PreparedScan,
+    /// The current scan's own points (all but a cloud's placed ones): what the
+    /// matched share is taken over.
+    own_points: usize,
     noise: f64,
     /// RMS range of the current points (m).
     rms_range: f64,
@@ -294,7 +297,6 @@ impl Pair<'_> {
         let mut sum_abs = 0.0;
         // The share is of the current scan's own points (a cloud's placed ones help
         // the fit only; see `PreparedScan::from_points`).
-        let own = |k: usize| !self.current_scan.is_placed(k);
         let mut used_own = 0usize;
         // Truncated χ²: every current point costs at most COST_CAP², matched or not.
         let mut cost = (self.current.len() - matches.len()) as f64 * COST_CAP * COST_CAP;
@@ -304,7 +306,7 @@ impl Pair<'_> {
                 continue;
             }
             sum_abs += m.residual.abs();
-            used_own += usize::from(own(m.point));
+            used_own += usize::from(!self.current_scan.is_placed(m.point));
             info.add(
                 self.current_rays[m.point],
                 self.current[m.point],
@@ -341,8 +343,7 @@ impl Pair<'_> {
             weakest_direction: unc.weakest_direction,
             residual_spread,
             noise_sigma: self.noise,
-            matched_share: used_own as f64
-                / (0..self.current.len()).filter(|&k| own(k)).count().max(1) as f64,
+            matched_share: used_own as f64 / self.own_points.max(1) as f64,
             starts: 1,
         };
         let sparse = IcpParams {
@@ -390,6 +391,9 @@ pub(crate) fn match_sparse(
         .sum::<f64>()
         / current_points.len().max(1) as f64)
         .sqrt();
+    let own_points = (0..current_points.len())
+        .filter(|&k| !current.is_placed(k))
+        .count();
     let pair = Pair {
         rms_range,
         grid: NearestGrid::new(&reference_points, CELL, COARSE.gate),
@@ -397,6 +401,7 @@ pub(crate) fn match_sparse(
         lines: lines.lines,
         current: current_points,
         current_rays,
+        own_points,
         current_scan: current,
         noise,
     };

@@ -86,18 +86,18 @@ fn cloud(
     params: &IcpParams,
 ) -> Option<(PreparedScan, u32)> {
     let own = prepared.get(&anchor)?.points();
-    let mut points = Vec::new();
+    let mut placed_points = Vec::new();
     let mut placed = 0;
     for n in neighbours {
         let (Some(scan), Some(pose)) = (prepared.get(&n), source.odometry(predictor, anchor, n))
         else {
             continue;
         };
-        points.extend(scan.points().iter().map(|p| pose.transform_point(*p)));
+        placed_points.extend(scan.points().iter().map(|p| pose.transform_point(*p)));
         placed += 1;
     }
     Some((
-        PreparedScan::from_points(own, &points, params).ok()?,
+        PreparedScan::from_points(own, &placed_points, params).ok()?,
         placed,
     ))
 }
