@@ -87,6 +87,9 @@ struct Yield {
     /// Per accepted match (same order): matched with its scans densified by their
     /// neighbours (`odocal_pipeline::local_map`).
     neighboured: Vec<bool>,
+    /// Per accepted match (same order): matched along a corridor, one direction left
+    /// free (`odocal_icp::IcpResult::free_direction`).
+    free: Vec<bool>,
 }
 
 impl Yield {
@@ -100,6 +103,7 @@ impl Yield {
             .extend_from_slice(&other.predicted_beyond);
         self.chained.extend_from_slice(&other.chained);
         self.neighboured.extend_from_slice(&other.neighboured);
+        self.free.extend_from_slice(&other.free);
         for (k, v) in &other.rejections {
             *self.rejections.entry(k).or_default() += v;
         }
@@ -161,6 +165,20 @@ impl Yield {
         out
     }
 
+    /// Accepted matches that leave a direction free, and of those the ones whose
+    /// NEES is beyond χ²(3)'s 99.7 % level: wrong in the directions they fix (along
+    /// the free one their covariance is a metre wide).
+    fn free_uncovered(&self) -> (usize, usize) {
+        let free = self.free.iter().filter(|f| **f).count();
+        let uncovered = self
+            .nees
+            .iter()
+            .zip(&self.free)
+            .filter(|(n, f)| **f && **n > NEES_997)
+            .count();
+        (free, uncovered)
+    }
+
     /// How many accepted matches the matcher's own covariances put beyond 5 mm / 0.5°
     /// of the truth (the sum of their probabilities): what [`Yield::wrong`] would be
     /// if every covariance were right.
@@ -204,7 +222,7 @@ impl Yield {
             .map(|(k, n)| format!("{k} {n}"))
             .collect();
         format!(
-            "| {label} | {} | {} | {}/{} ({:.0} %) | {} | {rd:.1} mm / {ra:.2}° | {wd:.1} mm / {wa:.2}° | {} ({:.0} %) | {:.0} ({:.0} %) | {} | {:.1}, {:.1} % | {} | {} ({}) | {} ({}, {:.0}) |",
+            "| {label} | {} | {} | {}/{} ({:.0} %) | {} | {rd:.1} mm / {ra:.2}° | {wd:.1} mm / {wa:.2}° | {} ({:.0} %) | {:.0} ({:.0} %) | {} | {:.1}, {:.1} % | {} | {} ({}) | {} ({}, {:.0}) | {} ({}) |",
             self.tried,
             self.overlapping,
             self.overlapping_matched,
@@ -224,11 +242,13 @@ impl Yield {
             self.neighboured_wrong().0,
             self.neighboured_wrong().1,
             self.neighboured_wrong().2,
+            self.free_uncovered().0,
+            self.free_uncovered().1,
         )
     }
 }
 
-const TABLE_HEADER: &str = "| preset, seeds | pairs tried | true overlap ≥ ½ | matched of those | accepted | RMS error | worst error | beyond 5 mm / 0.5° | beyond, as their own σ predict | of those, NEES > 14.2 | NEES: mean, share > 14.2 | rejections | matched through scans between (beyond) | matched with neighbouring scans (beyond, as their own σ predict) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+const TABLE_HEADER: &str = "| preset, seeds | pairs tried | true overlap ≥ ½ | matched of those | accepted | RMS error | worst error | beyond 5 mm / 0.5° | beyond, as their own σ predict | of those, NEES > 14.2 | NEES: mean, share > 14.2 | rejections | matched through scans between (beyond) | matched with neighbouring scans (beyond, as their own σ predict) | matched along a corridor, one direction free (NEES > 14.2) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
 
 /// The share of the returns of `second` (taken from `p2`) that the sensor at `p1` sees
 /// too: the ray from `p1` toward each point reaches it (nothing nearer in between,
@@ -300,7 +320,7 @@ fn measure_in(config: SimConfig, world: &World) -> Yield {
             scans[i].sensor
         }
     };
-    let matched: BTreeMap<(usize, usize), (Pose2, Covariance, bool, bool)> = synced
+    let matched: BTreeMap<(usize, usize), (Pose2, Covariance, [bool; 3])> = synced
         .samples
         .iter()
         .map(|s| {
@@ -309,8 +329,11 @@ fn measure_in(config: SimConfig, world: &World) -> Yield {
                 (
                     s.icp.pose,
                     s.icp.covariance,
-                    s.icp.links > 1,
-                    s.icp.neighbours > 0,
+                    [
+                        s.icp.links > 1,
+                        s.icp.neighbours > 0,
+                        !s.icp.fixes_every_direction(),
+                    ],
                 ),
             )
         })
@@ -335,9 +358,10 @@ fn measure_in(config: SimConfig, world: &World) -> Yield {
                 y.overlapping_matched += 1;
             }
         }
-        if let Some((pose, cov, chained, neighboured)) = accepted {
+        if let Some((pose, cov, [chained, neighboured, free])) = accepted {
             y.chained.push(*chained);
             y.neighboured.push(*neighboured);
+            y.free.push(*free);
             let truth = a.inverse().compose(&b);
             let e = truth.inverse().compose(pose);
             y.errors
@@ -759,40 +783,58 @@ fn sparse_pairs_refused_alone_are_matched_with_their_neighbouring_scans() {
     );
 }
 
-/// The pairs matched with their neighbouring scans are reported alike in the
-/// summary, `results.json` (`neighbour_matches`) and the tuples (`icp_neighbours`),
-/// and the summary says how many scans densified each one.
-#[test]
-fn pairs_matched_with_their_neighbouring_scans_are_reported_in_every_output() {
-    let dir = common::temp_dir("neighbours");
+/// Runs the binary with `args`; its standard output (the run must succeed).
+fn run_odocal(args: &[&str]) -> String {
+    let o = common::odocal(args);
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// A 20 s `neato-lds` log of `seed` calibrated (`--accept-weak`) through the binary
+/// in a temporary directory named after `tag`: the directory, the output directory,
+/// the summary and `results.json`.
+fn neato_calibration(
+    tag: &str,
+    seed: u64,
+) -> (
+    std::path::PathBuf,
+    std::path::PathBuf,
+    String,
+    serde_json::Value,
+) {
+    let dir = common::temp_dir(tag);
     let prefix = dir.join("neato");
     let out = dir.join("out");
     let log = prefix.with_extension("log");
-    let run = |args: &[&str]| {
-        let o = common::odocal(args);
-        assert!(o.status.success(), "{}", common::stderr(&o));
-        String::from_utf8_lossy(&o.stdout).into_owned()
-    };
-    run(&[
+    run_odocal(&[
         "simulate",
         "--preset",
         "neato-lds",
         "--seed",
-        "5",
+        &seed.to_string(),
         "--duration",
         "20",
         "--out",
         prefix.to_str().unwrap(),
     ]);
-    let summary = run(&[
+    let summary = run_odocal(&[
         "calibrate",
         "--accept-weak",
         "--out",
         out.to_str().unwrap(),
         log.to_str().unwrap(),
     ]);
-    let results: serde_json::Value =
+    let results =
         serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    (dir, out, summary, results)
+}
+
+/// The pairs matched with their neighbouring scans are reported alike in the
+/// summary, `results.json` (`neighbour_matches`) and the tuples (`icp_neighbours`),
+/// and the summary says how many scans densified each one.
+#[test]
+fn pairs_matched_with_their_neighbouring_scans_are_reported_in_every_output() {
+    let (dir, out, summary, results) = neato_calibration("neighbours", 5);
     let n = results["neighbour_matches"].as_u64().unwrap();
     assert!(n > 0, "{summary}");
     let tuples = std::fs::read_to_string(out.join("samples.tuple")).unwrap();
@@ -810,5 +852,62 @@ fn pairs_matched_with_their_neighbouring_scans_are_reported_in_every_output() {
         summary.contains("densified by the scan beyond it"),
         "{summary}"
     );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The pairs matched along a corridor (one direction left free) are reported alike
+/// in the summary, `results.json` (`free_direction_matches`) and the tuples
+/// (`free_direction`), and `odocal solve` honours the tuples' free directions: the
+/// free samples' ŝ moved 5 cm along them give the same estimate.
+#[test]
+fn pairs_matched_along_a_corridor_are_reported_and_solved_alike() {
+    // Seed 1 drives along a wall.
+    let (dir, out, summary, results) = neato_calibration("corridor", 1);
+    let n = results["free_direction_matches"].as_u64().unwrap();
+    assert!(n > 0, "{summary}");
+    assert!(
+        summary.contains(&format!("matched along a corridor: {n} pairs")),
+        "{summary}"
+    );
+    let tuples = out.join("samples.tuple");
+    let records: Vec<serde_json::Value> = std::fs::read_to_string(&tuples)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let free = records
+        .iter()
+        .filter(|t| t["free_direction"].is_array())
+        .count() as u64;
+    assert_eq!(free, n);
+    // The free samples' ŝ moved 5 cm along their free direction.
+    let moved: Vec<String> = records
+        .iter()
+        .map(|t| {
+            let mut t = t.clone();
+            if let Some(d) = t["free_direction"].as_array().cloned() {
+                let d: Vec<f64> = d.iter().map(|v| v.as_f64().unwrap()).collect();
+                let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+                for (c, v) in d.iter().enumerate() {
+                    let sm = t["sm"][c].as_f64().unwrap();
+                    t["sm"][c] = (sm + 0.05 * v / norm).into();
+                }
+            }
+            t.to_string()
+        })
+        .collect();
+    let moved_path = dir.join("moved.tuple");
+    std::fs::write(&moved_path, moved.join("\n")).unwrap();
+    let solve = |path: &std::path::Path| -> serde_json::Value {
+        serde_json::from_str(&run_odocal(&["solve", "--json", path.to_str().unwrap()])).unwrap()
+    };
+    let (a, b) = (solve(&tuples), solve(&moved_path));
+    for key in ["r_l", "r_r", "b", "l_x", "l_y", "l_theta"] {
+        let (x, y) = (a[key].as_f64().unwrap(), b[key].as_f64().unwrap());
+        assert!(
+            (x - y).abs() <= 1e-9 * x.abs().max(0.1),
+            "{key}: {x} and {y}"
+        );
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -83,6 +83,7 @@ fn parse_matcher_bias(text: &str) -> Result<[f64; 3], String> {
 pub fn sample_from_record(rec: &TupleRecord) -> Sample {
     let mut s = Sample::from_speeds(rec.t, rec.phi_l, rec.phi_r, Pose2::from_array(rec.sm));
     s.sm_cov = rec.sm_cov;
+    s.free_direction = rec.free_direction;
     s.scan_times = rec.t0.zip(rec.t1).map(|(t0, t1)| [t0, t1]);
     s.profile = rec.profile.as_ref().map(|pieces| {
         pieces

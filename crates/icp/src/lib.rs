@@ -69,7 +69,9 @@
 //!     reference point's nearest neighbours (`neighbourhood_lines`), whichever rays
 //!     they come from. Distinct results that explain the scans about equally well
 //!     are refused as ambiguous; a result uncertain along a wall is kept with its
-//!     covariance (only the condition number flags it ill-conditioned).
+//!     covariance; one ill-conditioned along a single direction (a corridor) keeps
+//!     the first guess there and leaves that direction free (`free_direction`,
+//!     [`IcpResult::free_direction`]).
 //!
 //! ```no_run
 //! use odocal_icp::{IcpParams, Matcher, PreparedScan};
@@ -92,6 +94,7 @@ mod correspondence;
 mod cost_envelope;
 mod covariance;
 mod error;
+mod free_direction;
 mod matcher;
 mod nearest_grid;
 mod neighbourhood_lines;
@@ -105,6 +108,7 @@ mod sparse_fallback;
 mod trimming;
 
 pub use error::IcpError;
+pub use free_direction::FREE_VARIANCE;
 pub use matcher::{IcpResult, Matcher};
 pub use params::{IcpParams, NeighbourSearch};
 pub use preprocess::PreparedScan;

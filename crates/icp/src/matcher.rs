@@ -74,6 +74,13 @@ pub struct IcpResult {
     pub matched_share: f64,
     /// Starting points tried: 1 when the first guess led to the result.
     pub starts: u32,
+    /// A match that fixes two directions of the displacement and not the third (a
+    /// corridor; module `free_direction`): the free direction as a motion
+    /// `(x, y, θ)` (m, m, rad per unit). The pose keeps the first guess along it and
+    /// the covariance is [`crate::FREE_VARIANCE`] wide along it. `None` for a match
+    /// that fixes all three. Only the sparse scans' matcher gives such matches; the
+    /// primary path flags them `ill_conditioned`.
+    pub free_direction: Option<[f64; 3]>,
 }
 
 /// One used-or-not correspondence of the current iteration.
@@ -636,6 +643,7 @@ impl Matcher {
             noise_sigma: scans_noise(reference, current, params),
             matched_share: (used as f64 / self.lined_not_skipped(current).max(1) as f64).min(1.0),
             starts: 1,
+            free_direction: None,
         };
         let result = if result.matched_share < params.min_matched_share {
             // Short of the share: leave out of it the current points that land where

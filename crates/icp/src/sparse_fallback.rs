@@ -23,6 +23,7 @@
 use crate::consistency::{check_consistency, robust_spread};
 use crate::correlative::{search, Candidate, Level};
 use crate::covariance::{InformationSum, RayResiduals};
+use crate::free_direction::free_if_corridor;
 use crate::matcher::check_ending;
 use crate::nearest_grid::NearestGrid;
 use crate::neighbourhood_lines::{
@@ -270,13 +271,14 @@ impl Pair<'_> {
             history[iterations as usize % history.len()] = fingerprint;
         }
         check_ending(anchor, &pose, converged, iterations, last_step, params)?;
-        self.result(pose, gate(iterations), iterations, params)
+        self.result(pose, anchor, gate(iterations), iterations, params)
     }
 
     /// The result at `pose`: covariance, consistency.
     fn result(
         &self,
         pose: Pose2,
+        anchor: &Pose2,
         gate: f64,
         iterations: u32,
         params: &IcpParams,
@@ -345,6 +347,7 @@ impl Pair<'_> {
             noise_sigma: self.noise,
             matched_share: used_own as f64 / self.own_points.max(1) as f64,
             starts: 1,
+            free_direction: None,
         };
         let sparse = IcpParams {
             min_matched_share: params.min_matched_share.min(if self.current_scan.cloud {
@@ -355,6 +358,8 @@ impl Pair<'_> {
             ..params.clone()
         };
         check_consistency(&result, &sparse)?;
+        // Along a corridor: the two directions the scans fix, the third left free.
+        let result = free_if_corridor(result, anchor, self.rms_range, params.max_condition_number);
         Ok(Refined { result, cost })
     }
 }
@@ -644,24 +649,52 @@ mod tests {
         );
     }
 
+    /// `r` fixes `truth`'s rotation and its displacement across walls along x, and
+    /// leaves x free at the guess's `guess_x`.
+    fn free_along_x(r: &IcpResult, truth: &Pose2, guess_x: f64) {
+        let d = r.free_direction.expect("a direction left free");
+        assert!(!r.ill_conditioned, "{r:?}");
+        assert!(d[0].abs() > 0.999, "{d:?}");
+        assert!((r.pose.x - guess_x).abs() < 1e-6, "{r:?}");
+        assert!((r.pose.y - truth.y).abs() < 1e-5, "{r:?}");
+        assert!((r.pose.theta - truth.theta).abs() < 1e-5, "{r:?}");
+        assert!(r.covariance[0][0] >= 0.99 * crate::FREE_VARIANCE, "{r:?}");
+        assert!(
+            r.covariance[1][1] < 1e-9 && r.covariance[2][2] < 1e-9,
+            "{r:?}"
+        );
+    }
+
+    /// Along a corridor without ends the scans fix the rotation and the
+    /// displacement across it, not along it: the match keeps the guess there and
+    /// leaves that direction free (its covariance a metre wide along it).
     #[test]
-    fn refuses_a_corridor_without_ends() {
+    fn a_corridor_without_ends_leaves_the_direction_along_it_free() {
         let params = IcpParams::default();
         let walls = vec![([-60.0, -1.0], [60.0, -1.0]), ([-60.0, 1.2], [60.0, 1.2])];
         let (a, b) = (Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.1, 0.02, 0.03));
         let reference = prepare(&scan(&walls, &a, 3, 0), &params);
         let current = prepare(&scan(&walls, &b, 3, 1), &params);
-        let r = match_sparse(&reference, &current, Pose2::IDENTITY, &params);
-        assert!(
-            !matches!(&r, Ok(r) if !r.ill_conditioned),
-            "a displacement along a corridor called determined: {r:?}"
-        );
+        let truth = a.between(&b);
+        let guess = Pose2::new(0.05, 0.0, 0.0);
+        let r = match_sparse(&reference, &current, guess, &params).unwrap();
+        free_along_x(&r, &truth, guess.x);
+        // Scans of a room: every direction fixed.
+        let walls = room();
+        let (a, b) = (Pose2::new(0.1, -0.2, 0.3), Pose2::new(0.22, -0.15, 0.38));
+        let reference = prepare(&scan(&walls, &a, 3, 0), &params);
+        let current = prepare(&scan(&walls, &b, 3, 1), &params);
+        let truth = a.between(&b);
+        let guess = Pose2::new(truth.x - 0.04, truth.y + 0.03, truth.theta - 0.05);
+        let r = match_sparse(&reference, &current, guess, &params).unwrap();
+        assert!(r.free_direction.is_none() && !r.ill_conditioned, "{r:?}");
     }
 
+    /// Posts every 0.4 m along a wall, no ends in sight: shifted by one period the
+    /// scans agree as well as at the truth. Refused, or matched with the direction
+    /// along the wall left free at the guess: never a displacement along it.
     #[test]
-    fn refuses_repeated_structure() {
-        // Posts every 0.4 m along a wall, no ends in sight: shifted by one period the
-        // scans agree as well as at the truth.
+    fn repeated_structure_fixes_no_displacement_along_it() {
         let mut walls = vec![([-60.0, -1.0], [60.0, -1.0])];
         for k in -30..=30 {
             let x = 0.4 * k as f64;
@@ -674,11 +707,10 @@ mod tests {
         let reference = prepare(&scan(&walls, &a, 2, 0), &params);
         let current = prepare(&scan(&walls, &b, 2, 1), &params);
         // The guess halfway between the truth and the truth shifted by one period.
-        let r = match_sparse(&reference, &current, Pose2::new(0.0, 0.0, 0.0), &params);
-        assert!(
-            !matches!(&r, Ok(r) if !r.ill_conditioned),
-            "a repeated structure called determined: {r:?}"
-        );
+        match match_sparse(&reference, &current, Pose2::IDENTITY, &params) {
+            Ok(r) if !r.ill_conditioned => free_along_x(&r, &a.between(&b), 0.0),
+            _ => {}
+        }
     }
 
     #[test]

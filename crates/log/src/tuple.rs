@@ -2,7 +2,7 @@
 //!
 //! A tuple file is a stream of JSON objects (several may share a line), each
 //! `{ "T": s, "phi_l": rad/s, "phi_r": rad/s, "sm": [x, y, theta], … }`. Optional
-//! fields `t0`, `t1`, `sm_cov`, `profile` are ours; any other field (e.g. ICP
+//! fields `t0`, `t1`, `sm_cov`, `free_direction`, `profile` are ours; any other field (e.g. ICP
 //! statistics) is preserved in [`TupleRecord::extra`].
 
 use crate::error::LogError;
@@ -34,6 +34,11 @@ pub struct TupleRecord {
     /// Covariance of `sm`, when known.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sm_cov: Option<[[f64; 3]; 3]>,
+    /// The motion `(x, y, θ)` along which `sm` says nothing (a match along a
+    /// corridor keeps its first guess there), when there is one: the solver gives
+    /// the residual's component along it no weight.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_direction: Option<[f64; 3]>,
     /// Pieces inside the interval: (duration s, left wheel rotation rad, right wheel
     /// rotation rad), when the wheel speeds were not constant.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -54,6 +59,7 @@ impl TupleRecord {
             t0: None,
             t1: None,
             sm_cov: None,
+            free_direction: None,
             profile: None,
             extra: serde_json::Map::new(),
         }

@@ -216,9 +216,11 @@ pub fn match_through_intermediate_scans(
             let Some(links) = chains[c].as_mut() else {
                 continue;
             };
-            match result {
-                Ok(m) => links[k].matched = Some(m),
-                Err(_) => {
+            // A link that leaves a direction free is split like a refused one: the
+            // composition carries covariances, not free directions.
+            match result.ok().filter(MatchStats::fixes_every_direction) {
+                Some(m) => links[k].matched = Some(m),
+                None => {
                     let split =
                         halves(links[k].first, links[k].second).filter(|_| links.len() < MAX_LINKS);
                     match split {
@@ -296,6 +298,7 @@ mod tests {
             mean_residual: 0.002,
             links: 1,
             neighbours: 0,
+            free_direction: None,
         }
     }
 

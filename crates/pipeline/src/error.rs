@@ -19,7 +19,8 @@ pub enum PipelineError {
         why_too_few(.discarded, .match_rejections, *.scan_returns)
     )]
     TooFewSamples {
-        /// Samples that survived.
+        /// Samples that survived, not counting matches along a corridor (which fix
+        /// two directions of ŝ only).
         usable: usize,
         /// Scan pairs considered.
         pairs: usize,

@@ -28,6 +28,11 @@ pub struct MatchStats {
     /// densified by their neighbours (see [`crate::local_map`]); 0 for a match of
     /// the two scans alone.
     pub neighbours: u32,
+    /// The motion `(x, y, θ)` along which the scans fix nothing (a corridor: see
+    /// [`odocal_icp::IcpResult::free_direction`]); ŝ keeps the first guess there and
+    /// the calibration gives it no weight. `None` when the match fixes every
+    /// direction.
+    pub free_direction: Option<[f64; 3]>,
 }
 
 impl MatchStats {
@@ -42,7 +47,13 @@ impl MatchStats {
             mean_residual: result.mean_residual,
             links: 1,
             neighbours: 0,
+            free_direction: result.free_direction,
         }
+    }
+
+    /// Does the match fix every direction of ŝ (no [`MatchStats::free_direction`])?
+    pub fn fixes_every_direction(&self) -> bool {
+        self.free_direction.is_none()
     }
 }
 

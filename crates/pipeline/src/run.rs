@@ -207,9 +207,20 @@ pub fn synchronize_and_match(
         let subset = bootstrap_subset(kept.len());
         let sub_pairs: Vec<(usize, usize)> = subset.iter().map(|&i| index_pairs[i]).collect();
         let identity = vec![Pose2::IDENTITY; subset.len()];
-        let results = match_pairs(&log.scans, &sub_pairs, &identity, &log_icp, || {
+        // A match that leaves a direction free keeps its guess there, here the
+        // identity: refused, so that it is matched again from the odometry guess.
+        let results: Vec<_> = match_pairs(&log.scans, &sub_pairs, &identity, &log_icp, || {
             progress.advance()
-        });
+        })
+        .into_iter()
+        .map(|r| match r {
+            Ok(m) if !m.fixes_every_direction() => Err(MatchFailure::new(
+                Rejection::Conditioning,
+                "the scans do not constrain the displacement from an identity guess",
+            )),
+            other => other,
+        })
+        .collect();
         let samples: Vec<_> = subset
             .iter()
             .zip(&results)
@@ -438,9 +449,16 @@ pub fn resynchronize(log: &Log, synced: &mut Synchronized, offset: f64) {
 }
 
 fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineError> {
-    if synced.samples.len() < MIN_SAMPLES {
+    // Samples that leave a direction free (a corridor's) add to the others but do
+    // not count toward the minimum: alone they determine less than a sample each.
+    let usable = synced
+        .samples
+        .iter()
+        .filter(|s| s.icp.fixes_every_direction())
+        .count();
+    if usable < MIN_SAMPLES {
         return Err(PipelineError::TooFewSamples {
-            usable: synced.samples.len(),
+            usable,
             pairs: synced.pairs,
             needed: MIN_SAMPLES,
             discarded: synced.discarded.clone(),

@@ -33,6 +33,7 @@ impl PairSample {
             sm_cov: use_icp_covariance.then_some(self.icp.covariance),
             scan_times: Some([self.pair.t0, self.pair.t1]),
             read_time_sigma: None,
+            free_direction: self.icp.free_direction,
             profile: use_profile.then(|| {
                 self.wheel
                     .profile
@@ -64,6 +65,7 @@ impl PairSample {
         rec.t0 = Some(self.pair.t0);
         rec.t1 = Some(self.pair.t1);
         rec.sm_cov = Some(self.icp.covariance);
+        rec.free_direction = self.icp.free_direction;
         rec.profile = Some(
             w.profile
                 .iter()
@@ -103,6 +105,7 @@ pub fn wheel_only_sample(w: &WheelMotion) -> Sample {
         sm_cov: None,
         scan_times: None,
         read_time_sigma: None,
+        free_direction: None,
         profile: Some(
             w.profile
                 .iter()
@@ -187,6 +190,7 @@ mod tests {
                 mean_residual: 1e-3 / (1.0 + x),
                 links: 1,
                 neighbours: 0,
+                free_direction: None,
             },
         }
     }

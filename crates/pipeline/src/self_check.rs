@@ -59,8 +59,11 @@ pub fn closure_check(
         .windows(2)
         // Direct matches only: a pair matched through the scans between its two was
         // refused directly, and so, mostly, is the pair twice as long over it.
+        // Matches that leave a direction free keep the guess there: no closure.
         .filter(|w| {
-            w[0].pair.second == w[1].pair.first && w[0].icp.links == 1 && w[1].icp.links == 1
+            w[0].pair.second == w[1].pair.first
+                && w.iter()
+                    .all(|s| s.icp.links == 1 && s.icp.fixes_every_direction())
         })
         .map(|w| (&w[0].icp, &w[1].icp, (w[0].pair.first, w[1].pair.second)))
         .collect();
@@ -78,7 +81,9 @@ pub fn closure_check(
     let direct = match_pairs(scans, &pairs, &chained, params, || {});
     let (mut sum_xy, mut sum_theta, mut n) = (0.0, 0.0, 0usize);
     for (d, c) in direct.iter().zip(&chained) {
-        let Ok(d) = d else { continue };
+        let Some(d) = d.as_ref().ok().filter(|d| d.fixes_every_direction()) else {
+            continue;
+        };
         let e = c.between(&d.pose);
         sum_xy += e.x * e.x + e.y * e.y;
         sum_theta += wrap_angle(e.theta).powi(2);

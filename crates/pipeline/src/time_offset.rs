@@ -136,7 +136,8 @@ impl Problem<'_> {
         let total: f64 = samples
             .iter()
             .map(|s| {
-                let r = predictor.residual(s);
+                // Along a free direction ŝ is odometry's guess, not a measurement.
+                let r = s.measured_part(predictor.residual(s));
                 let q: f64 = (0..3).map(|c| (r[c] / self.scale[c]).powi(2)).sum();
                 q.min(CAP)
             })
@@ -188,7 +189,10 @@ pub fn estimate_time_offset(
     };
     let samples = problem.samples_at(start, 1);
     let predictor = Predictor::new(&base.params, opts.use_profile);
-    let residuals: Vec<[f64; 3]> = samples.iter().map(|s| predictor.residual(s)).collect();
+    let residuals: Vec<[f64; 3]> = samples
+        .iter()
+        .map(|s| s.measured_part(predictor.residual(s)))
+        .collect();
     problem.scale = residual_scale(&residuals);
 
     // The coarse grid only has to find the basin: a subsample keeps it fast on long

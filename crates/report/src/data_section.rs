@@ -21,7 +21,7 @@ pub(crate) struct Row {
 }
 
 /// The rows, in order. `time_offset_sigma_s` is shown with `time_offset_s`.
-pub(crate) const ROWS: [Row; 26] = [
+pub(crate) const ROWS: [Row; 27] = [
     Row { key: "log_contents", label: "What the input holds", meaning: "scans and wheel records read, lines skipped (lenient mode) and messages not understood" },
     Row { key: "samples_used", label: "Samples used", meaning: "scan pairs with their wheel rotations that entered the final estimate" },
     Row { key: "samples_synchronized", label: "Samples synchronized", meaning: "scan pairs matched and given the wheel rotations between their two scans, before outliers were trimmed" },
@@ -31,6 +31,7 @@ pub(crate) const ROWS: [Row; 26] = [
     Row { key: "match_rejections", label: "Failed matches, by reason", meaning: "why the scan matcher refused the pairs it could not match" },
     Row { key: "chained_matches", label: "Pairs matched through the scans between", meaning: "pairs refused when matched directly and matched as a chain of shorter matches (2 to 4) through the scans between their two; ŝ is the chain's composition" },
     Row { key: "neighbour_matches", label: "Pairs matched with their neighbouring scans", meaning: "pairs of sparse scans refused when matched alone and matched with each scan densified by the scan beyond it (the one before the first, the one after the second), placed by odometry" },
+    Row { key: "free_direction_matches", label: "Pairs matched along a corridor", meaning: "pairs of sparse scans whose match fixes the rotation and the displacement across the walls but not along them (a corridor, one wall): ŝ keeps odometry's first guess there, and the calibration gives that direction no weight" },
     Row { key: "match_self_check", label: "Scan-matching self-check", meaning: "the matcher's own error, from the closure of consecutive scan triples (a lower bound)" },
     Row { key: "stride", label: "Stride", meaning: "scans from the first to the second scan of a pair" },
     Row { key: "interval_s", label: "Pair interval", meaning: "target time (s) between the two scans of a pair" },

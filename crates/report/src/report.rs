@@ -59,6 +59,11 @@ pub struct Report {
     /// densified by the scan beyond it, placed by odometry (see
     /// `odocal_pipeline::local_map`), among the samples synchronized.
     pub neighbour_matches: usize,
+    /// Pairs of sparse scans matched along a corridor, among the samples
+    /// synchronized: the match fixes two directions of the displacement (across the
+    /// walls, the rotation) and not the third, where ŝ keeps odometry's first guess
+    /// and the calibration gives it no weight (see `odocal_icp::IcpResult::free_direction`).
+    pub free_direction_matches: usize,
     /// The scan matcher's own error per pair, measured on this log by the closure of
     /// scan triples; absent when too few triples close.
     pub match_self_check: Option<MatchSelfCheck>,
@@ -256,6 +261,12 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
             .samples
             .iter()
             .filter(|s| s.icp.neighbours > 0)
+            .count(),
+        free_direction_matches: outcome
+            .synced
+            .samples
+            .iter()
+            .filter(|s| !s.icp.fixes_every_direction())
             .count(),
         match_self_check: outcome.synced.match_self_check,
         stride: e.stride,
@@ -462,6 +473,13 @@ impl fmt::Display for Report {
                     1 => "the scan".to_string(),
                     n => format!("the {n} scans"),
                 }
+            )?;
+        }
+        if self.free_direction_matches > 0 {
+            writeln!(
+                f,
+                "  matched along a corridor: {} pairs of sparse scans fix the rotation and the displacement across the walls only (along them ŝ keeps odometry's guess, which gets no weight)",
+                self.free_direction_matches
             )?;
         }
         if let Some(c) = &self.match_self_check {

@@ -20,7 +20,7 @@ use crate::sample::Sample;
 use crate::shared_scans::{score_covariance, SharedScanNoise};
 use crate::step1::{step1, Step1};
 use crate::step2::{build_m, solve_m, Step2, A_SINGULAR_CONDITION};
-use crate::trimming::Trim;
+use crate::trimming::{robust_location_scale, Trim, CHI2_3DOF_9999};
 use nalgebra::SMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -281,6 +281,42 @@ fn residuals_at(samples: &[Packed], params: &Params) -> Vec<[f64; 3]> {
         .collect()
 }
 
+/// The samples of `free` (each with a [`Sample::free_direction`]) to keep beside the
+/// samples that fix every direction, whose residuals at the closed form `params`
+/// are `fixed_residuals`: under `trim`, a free sample is kept when its residual,
+/// whitened by the fixed residuals' robust location and scale and with its free
+/// direction projected out, has a squared norm within the χ² rule's threshold
+/// ([`CHI2_3DOF_9999`] for the other rules; every one without trimming).
+fn free_kept<'a>(
+    free: &[Packed<'a>],
+    params: &Params,
+    fixed_residuals: &[[f64; 3]],
+    trim: Trim,
+) -> Vec<Packed<'a>> {
+    let threshold = match trim {
+        Trim::None => return free.to_vec(),
+        Trim::Chi2 { threshold, .. } => threshold,
+        Trim::Icra { .. } | Trim::Tro { .. } => CHI2_3DOF_9999,
+    };
+    let (loc, scale) = robust_location_scale(fixed_residuals);
+    free.iter()
+        .zip(residuals_at(free, params))
+        .filter(|(p, e)| {
+            let Some(d) = p.free_direction else {
+                return true;
+            };
+            let z: [f64; 3] = std::array::from_fn(|c| (e[c] - loc[c]) / scale[c]);
+            let d: [f64; 3] = std::array::from_fn(|c| d[c] / scale[c]);
+            let dd: f64 = d.iter().map(|v| v * v).sum();
+            let dz: f64 = (0..3).map(|c| d[c] * z[c]).sum();
+            let along = if dd > 0.0 { dz / dd } else { 0.0 };
+            let q: f64 = (0..3).map(|c| (z[c] - along * d[c]).powi(2)).sum();
+            q <= threshold
+        })
+        .map(|(p, _)| *p)
+        .collect()
+}
+
 /// The closed form with some parameters held (see [`crate::partial`]).
 fn closed_form_held(
     samples: &[Packed],
@@ -366,7 +402,18 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     };
     let tw = theta_weights.as_deref();
 
-    let mut active = Packed::all(samples, options.use_profile);
+    // The closed form, the trimming and the noise estimate use the samples that fix
+    // every direction of ŝ: along a free direction ŝ is not a measurement.
+    let (mut active, free): (Vec<Packed>, Vec<Packed>) = Packed::all(samples, options.use_profile)
+        .into_iter()
+        .partition(|p| p.free_direction.is_none());
+    if active.len() < MIN_SAMPLES {
+        return Err(SolveError::TooFewSamples {
+            got: active.len(),
+            needed: MIN_SAMPLES,
+            stage: "samples that fix every direction of ŝ (the others leave one free)".into(),
+        });
+    }
     let mut samples_per_round = vec![active.len()];
     let mut scratch = Scratch::default();
     // Held parameters enter the closed form; priors only the refinement, unless the
@@ -451,6 +498,16 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         Some(w) => (w, NoiseSource::SampleCovariance),
         None => (NoiseWeights::from_sigmas(sm_sigma), NoiseSource::Estimated),
     };
+    let weights = weights.with_free_directions(samples);
+    // The samples that leave a direction free join for the refinement, unless their
+    // residual in the directions they fix is an outlier at the closed form.
+    active.extend(free_kept(
+        &free,
+        &cf.params,
+        &scratch.residuals,
+        options.trim,
+    ));
+    active.sort_unstable_by_key(|p| p.index);
 
     // The last pass of the refinement (or one pass at the closed form) gives the
     // cost and the Fisher information at the estimate.

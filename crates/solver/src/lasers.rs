@@ -147,6 +147,7 @@ fn weights_of(own: &Calibration, samples: &[Sample]) -> NoiseWeights {
             NoiseWeights::Shared(own.sm_sigma.map(|s| 1.0 / s.max(SIGMA_FLOOR).powi(2)))
         }
     }
+    .with_free_directions(samples)
 }
 
 /// `(cost, H, g)` of the joint fit at `params`.

@@ -203,7 +203,8 @@ pub fn fit_lateral_slip(
         .filter(|&i| calibration.used.get(i).copied().unwrap_or(false))
         .collect();
     let weights = NoiseWeights::from_samples(samples)
-        .unwrap_or_else(|| NoiseWeights::from_sigmas(calibration.sm_sigma));
+        .unwrap_or_else(|| NoiseWeights::from_sigmas(calibration.sm_sigma))
+        .with_free_directions(samples);
     let constraints = &options.constraints;
     let use_profile = options.use_profile;
     let start = calibration.params.to_vector();

@@ -24,6 +24,31 @@ impl NoiseWeights {
         NoiseWeights::Shared(sigma.map(|s| 1.0 / s.max(SIGMA_FLOOR).powi(2)))
     }
 
+    /// The same weights with each sample's free direction
+    /// ([`Sample::free_direction`]) given none: `W − (Wδ)(Wδ)ᵀ / (δᵀWδ)`, the limit of
+    /// the information of a covariance made infinitely wide along `δ`. Unchanged
+    /// (and still shared) when no sample has a free direction; `samples` indexed like
+    /// the weights.
+    pub(crate) fn with_free_directions(self, samples: &[Sample]) -> Self {
+        if samples.iter().all(|s| s.free_direction.is_none()) {
+            return self;
+        }
+        let info = |k: usize| match &self {
+            NoiseWeights::Shared(w) => [[w[0], 0.0, 0.0], [0.0, w[1], 0.0], [0.0, 0.0, w[2]]],
+            NoiseWeights::PerSample(info) => info[k],
+        };
+        NoiseWeights::PerSample(
+            samples
+                .iter()
+                .enumerate()
+                .map(|(k, s)| match s.free_direction {
+                    Some(d) => without_direction(info(k), d),
+                    None => info(k),
+                })
+                .collect(),
+        )
+    }
+
     /// Each sample's own covariance, when every sample has one; `None` otherwise.
     /// The covariances must already have been checked (positive definite).
     pub(crate) fn from_samples(samples: &[Sample]) -> Option<Self> {
@@ -33,6 +58,17 @@ impl NoiseWeights {
             .collect::<Option<Vec<_>>>()
             .map(NoiseWeights::PerSample)
     }
+}
+
+/// The information `w` with the direction `d` taken out:
+/// `w − (w d)(w d)ᵀ / (dᵀ w d)` (`w` itself when `dᵀ w d` is not positive).
+fn without_direction(w: [[f64; 3]; 3], d: [f64; 3]) -> [[f64; 3]; 3] {
+    let wd: [f64; 3] = std::array::from_fn(|r| (0..3).map(|c| w[r][c] * d[c]).sum());
+    let dwd: f64 = (0..3).map(|r| d[r] * wd[r]).sum();
+    if dwd.is_nan() || dwd <= 0.0 {
+        return w;
+    }
+    std::array::from_fn(|r| std::array::from_fn(|c| w[r][c] - wd[r] * wd[c] / dwd))
 }
 
 /// Standard deviations (x, y, θ) of the residuals, mean removed, divided by `n − 1`

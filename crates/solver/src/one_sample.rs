@@ -110,7 +110,8 @@ pub(crate) fn resting_on_one_sample(
         .collect()
 }
 
-/// The covariance `W⁻¹` of sample `index`'s ŝ under `weights`.
+/// The covariance `W⁻¹` of sample `index`'s ŝ under `weights`; `None` when `W` is
+/// singular (a free direction) or not finite.
 fn sample_covariance(weights: &NoiseWeights, index: usize) -> Option<Matrix3<f64>> {
     match weights {
         NoiseWeights::Shared(w) => Some(Matrix3::from_diagonal(&nalgebra::Vector3::new(
@@ -119,8 +120,16 @@ fn sample_covariance(weights: &NoiseWeights, index: usize) -> Option<Matrix3<f64
             1.0 / w[2],
         ))),
         NoiseWeights::PerSample(info) => {
-            let w = info.get(index)?;
-            Matrix3::from_fn(|r, c| w[r][c]).try_inverse()
+            let w = Matrix3::from_fn(|r, c| info.get(index).map_or(f64::NAN, |w| w[r][c]));
+            // A sample with a free direction (no weight along it: singular) determines
+            // nothing along it; it is left out.
+            let eigenvalues = w.symmetric_eigenvalues();
+            let largest = eigenvalues.max();
+            let smallest = eigenvalues.min();
+            if smallest.is_nan() || smallest <= 1e-12 * largest {
+                return None;
+            }
+            w.try_inverse()
         }
     }
 }

@@ -1,5 +1,5 @@
-//! The fields the solver's repeated passes read, packed contiguously: 64 bytes per
-//! sample instead of a whole [`Sample`] (covariance, profile vector), rebuilt after
+//! The fields the solver's repeated passes read, packed contiguously: about 100 bytes
+//! per sample instead of a whole [`Sample`] (covariance, profile vector), rebuilt after
 //! each trimming round so that every pass streams through memory in order.
 
 use crate::kinematics::Pieces;
@@ -22,6 +22,8 @@ pub(crate) struct Packed<'a> {
     pub scan_times: Option<[f64; 2]>,
     /// Standard deviation of the read-time error of the encoder readings (s).
     pub read_time_sigma: Option<f64>,
+    /// The direction ŝ leaves free ([`Sample::free_direction`]), when there is one.
+    pub free_direction: Option<[f64; 3]>,
 }
 
 impl<'a> Packed<'a> {
@@ -34,6 +36,7 @@ impl<'a> Packed<'a> {
             index,
             scan_times: sample.scan_times,
             read_time_sigma: sample.read_time_sigma,
+            free_direction: sample.free_direction,
             profile: if use_profile {
                 sample.profile.as_deref()
             } else {

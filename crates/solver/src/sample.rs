@@ -45,6 +45,24 @@ pub struct Sample {
     /// the estimate accounts for (needs `scan_times`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub read_time_sigma: Option<f64>,
+    /// A motion `(x, y, θ)` along which `ŝ` says nothing (a match along a corridor,
+    /// whose scans fix the displacement across it and the rotation only), when there
+    /// is one. The residual's component along it gets no weight: the weights are the
+    /// limit of a covariance infinitely wide along it, whatever the noise model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_direction: Option<[f64; 3]>,
+}
+
+/// `e` without its component along `free` (orthogonal projection in `(x, y, θ)`;
+/// see [`Sample::measured_part`]).
+pub(crate) fn measured_part(e: [f64; 3], free: Option<[f64; 3]>) -> [f64; 3] {
+    let Some(d) = free else { return e };
+    let dd: f64 = d.iter().map(|v| v * v).sum();
+    if dd.is_nan() || dd <= 0.0 {
+        return e;
+    }
+    let along = (0..3).map(|c| d[c] * e[c]).sum::<f64>() / dd;
+    std::array::from_fn(|c| e[c] - along * d[c])
 }
 
 /// Relative tolerance for a profile's rotations to add up to the sample's totals.
@@ -62,6 +80,7 @@ impl Sample {
             profile: None,
             scan_times: None,
             read_time_sigma: None,
+            free_direction: None,
         }
     }
 
@@ -85,6 +104,7 @@ impl Sample {
             profile: Some(profile),
             scan_times: None,
             read_time_sigma: None,
+            free_direction: None,
         }
     }
 
@@ -100,10 +120,25 @@ impl Sample {
         self
     }
 
+    /// The same sample with a direction `ŝ` does not determine (see
+    /// [`Sample::free_direction`]).
+    pub fn with_free_direction(mut self, motion: [f64; 3]) -> Self {
+        self.free_direction = Some(motion);
+        self
+    }
+
     /// The same sample with a wheel-speed profile attached (totals unchanged).
     pub fn with_profile(mut self, profile: Vec<ProfileSegment>) -> Self {
         self.profile = Some(profile);
         self
+    }
+
+    /// `e` (a residual `ŝ_pred − ŝ` of this sample, or any error of its ŝ) without
+    /// its component along [`Sample::free_direction`] (orthogonal projection in
+    /// `(x, y, θ)`): the part ŝ measured. `e` itself for a sample that fixes every
+    /// direction.
+    pub fn measured_part(&self, e: [f64; 3]) -> [f64; 3] {
+        measured_part(e, self.free_direction)
     }
 
     /// Average left wheel speed over the interval (rad/s).
@@ -155,6 +190,19 @@ impl Sample {
                 return Err(SolveError::InvalidSample {
                     index,
                     reason: "sm_cov must be a symmetric positive definite 3×3 matrix".into(),
+                });
+            }
+        }
+        if let Some(motion) = &self.free_direction {
+            for (k, &v) in motion.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(non_finite(&format!("free_direction[{k}]"), v));
+                }
+            }
+            if motion.iter().all(|&v| v == 0.0) {
+                return Err(SolveError::InvalidSample {
+                    index,
+                    reason: "free_direction must not be zero".into(),
                 });
             }
         }

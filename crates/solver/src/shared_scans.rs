@@ -53,6 +53,7 @@ use crate::kinematics::{residual_of, wrap_fast, Pieces as WheelPieces, Predictor
 use crate::noise::NoiseWeights;
 use crate::packed::Packed;
 use crate::params::Params;
+use crate::sample::measured_part;
 use nalgebra::{Matrix3, SMatrix, Vector3};
 use serde::Serialize;
 use std::collections::{BTreeMap, HashMap};
@@ -235,7 +236,11 @@ pub(crate) fn score_covariance(
     for s in samples {
         let (pr, jac) = pred.predict_with_jacobian_pieces(s.pieces());
         let gk = Matrix3x6::from_fn(|i, j| jac[i][j]);
-        p.e.push(Vector3::from(residual_of(pr, &s.sm)));
+        // A free direction's residual is no scan's error (`Sample::free_direction`).
+        p.e.push(Vector3::from(measured_part(
+            residual_of(pr, &s.sm),
+            s.free_direction,
+        )));
         p.gw.push(gk.transpose() * weight(weights, s.index));
         p.g.push(gk);
     }

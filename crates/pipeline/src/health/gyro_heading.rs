@@ -309,6 +309,7 @@ mod tests {
                         mean_residual: 0.0,
                         links: 1,
                         neighbours: 0,
+                        free_direction: None,
                     },
                 }
             })
