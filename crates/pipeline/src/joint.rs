@@ -149,9 +149,14 @@ pub fn calibrate_logs_with_lasers(
         .collect();
     let samples = joint_samples(&outcomes, opts);
     let mut synced = merged(&outcomes);
-    if samples.len() < MIN_SAMPLES {
+    // As for one log: matches along a corridor do not count toward the minimum.
+    let usable = samples
+        .iter()
+        .filter(|s| s.free_direction.is_none())
+        .count();
+    if usable < MIN_SAMPLES {
         return Err(JointError::Joint(PipelineError::TooFewSamples {
-            usable: samples.len(),
+            usable,
             pairs: synced.pairs,
             needed: MIN_SAMPLES,
             discarded: synced.discarded,

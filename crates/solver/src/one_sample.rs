@@ -120,7 +120,8 @@ fn sample_covariance(weights: &NoiseWeights, index: usize) -> Option<Matrix3<f64
             1.0 / w[2],
         ))),
         NoiseWeights::PerSample(info) => {
-            let w = Matrix3::from_fn(|r, c| info.get(index).map_or(f64::NAN, |w| w[r][c]));
+            let w = info.get(index)?;
+            let w = Matrix3::from_fn(|r, c| w[r][c]);
             // A sample with a free direction (no weight along it: singular) determines
             // nothing along it; it is left out.
             let eigenvalues = w.symmetric_eigenvalues();
