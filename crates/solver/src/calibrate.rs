@@ -16,7 +16,7 @@ use crate::packed::Packed;
 use crate::params::Params;
 use crate::partial::{step1_held, step2_held};
 use crate::refine::{constrained_normal_equations, refine, Refinement};
-use crate::sample::Sample;
+use crate::sample::{measured_part, Sample};
 use crate::shared_scans::{score_covariance, SharedScanNoise};
 use crate::step1::{step1, Step1};
 use crate::step2::{build_m, solve_m, Step2, A_SINGULAR_CONDITION};
@@ -305,12 +305,10 @@ fn free_kept<'a>(
             let Some(d) = p.free_direction else {
                 return true;
             };
+            // Whitened, then projected as `Sample::measured_part` does.
             let z: [f64; 3] = std::array::from_fn(|c| (e[c] - loc[c]) / scale[c]);
             let d: [f64; 3] = std::array::from_fn(|c| d[c] / scale[c]);
-            let dd: f64 = d.iter().map(|v| v * v).sum();
-            let dz: f64 = (0..3).map(|c| d[c] * z[c]).sum();
-            let along = if dd > 0.0 { dz / dd } else { 0.0 };
-            let q: f64 = (0..3).map(|c| (z[c] - along * d[c]).powi(2)).sum();
+            let q: f64 = measured_part(z, Some(d)).iter().map(|v| v * v).sum();
             q <= threshold
         })
         .map(|(p, _)| *p)
