@@ -110,6 +110,6 @@ mod trimming;
 pub use error::IcpError;
 pub use free_direction::FREE_VARIANCE;
 pub use matcher::{IcpResult, Matcher};
-pub use params::{IcpParams, NeighbourSearch};
+pub use params::{GuessWindow, IcpParams, NeighbourSearch};
 pub use preprocess::PreparedScan;
 pub use sparse_fallback::coarse_rays;

@@ -201,11 +201,11 @@ impl Matcher {
         current: &PreparedScan,
         first_guess: Pose2,
     ) -> Result<IcpResult, IcpError> {
-        let params = self.params.clone();
-        params.validate()?;
+        self.params.validate()?;
         if !first_guess.is_finite() {
             return Err(IcpError::NonFiniteGuess(first_guess));
         }
+        let params = self.params.around(&first_guess);
         if crate::sparse_fallback::applies(reference, current, &params) {
             return crate::sparse_fallback::match_sparse(reference, current, first_guess, &params);
         }
@@ -803,14 +803,26 @@ impl Matcher {
 }
 
 /// The verdict on how an iteration ended: the correction from `anchor` (the first
-/// guess) beyond the limits, or no convergence, is an error (the order in which
-/// they are reported). Shared by the point-to-line matcher and the sparse fallback.
+/// guess) beyond the limits ([`check_correction`]), or no convergence, is an error
+/// (the order in which they are reported).
 pub(crate) fn check_ending(
     anchor: &Pose2,
     estimate: &Pose2,
     converged: bool,
     iterations: u32,
     last_step: (f64, f64),
+    params: &IcpParams,
+) -> Result<(), IcpError> {
+    check_correction(anchor, estimate, params)?;
+    check_convergence(converged, iterations, last_step)
+}
+
+/// A correction of `estimate` from `anchor` (the first guess) beyond
+/// `params.max_linear_correction` or `params.max_angular_correction` is an error.
+/// Shared by the point-to-line matcher and the sparse fallback.
+pub(crate) fn check_correction(
+    anchor: &Pose2,
+    estimate: &Pose2,
     params: &IcpParams,
 ) -> Result<(), IcpError> {
     let correction = anchor.between(estimate);
@@ -826,6 +838,16 @@ pub(crate) fn check_ending(
             max_angular: params.max_angular_correction,
         });
     }
+    Ok(())
+}
+
+/// Iterations that did not converge are an error. Shared by the point-to-line
+/// matcher and the sparse fallback.
+pub(crate) fn check_convergence(
+    converged: bool,
+    iterations: u32,
+    last_step: (f64, f64),
+) -> Result<(), IcpError> {
     if !converged {
         return Err(IcpError::FailedToConverge {
             iterations,

@@ -12,6 +12,20 @@ pub enum NeighbourSearch {
     KdTree,
 }
 
+/// A correction window that grows with the first guess (see
+/// [`IcpParams::guess_window`]): a match may end at most `xy + share · |t|` (m) and
+/// `theta + share · |θ|` (rad) from a guess `(t, θ)`. For guesses whose error is
+/// known (the pipeline's second pass: odometry with an estimate solved from the log).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GuessWindow {
+    /// The fixed part of the displacement's bound (m).
+    pub xy: f64,
+    /// The fixed part of the rotation's bound (rad).
+    pub theta: f64,
+    /// The share of the guessed displacement and rotation added.
+    pub share: f64,
+}
+
 /// Tuning of [`crate::Matcher`] and [`crate::PreparedScan`].
 ///
 /// Distances are in metres, angles in radians.
@@ -135,6 +149,12 @@ pub struct IcpParams {
     /// lines through metric neighbourhoods; see the crate documentation) instead of
     /// the primary path, whose local lines need runs of consecutive returns. 0: never.
     pub sparse_below_returns: usize,
+    /// A bound on the correction that grows with the first guess, within
+    /// `max_linear_correction` and `max_angular_correction`: for guesses whose error is
+    /// known to be a share of the motion (odometry with a solved estimate). `None`
+    /// (the default): the fixed bounds alone, for guesses of unknown quality (the
+    /// identity, a nominal typed by hand).
+    pub guess_window: Option<GuessWindow>,
 }
 
 impl Default for IcpParams {
@@ -172,6 +192,7 @@ impl Default for IcpParams {
             rotation_hypotheses: 3,
             basin_check_step: 0.02,
             sparse_below_returns: 160,
+            guess_window: None,
         }
     }
 }
@@ -242,6 +263,28 @@ impl IcpParams {
         if !(0.0..=1.0).contains(&self.min_matched_share) {
             return bad("min_matched_share must be in [0, 1]");
         }
+        if let Some(w) = &self.guess_window {
+            if !positive(w.xy) || !positive(w.theta) || !non_negative(w.share) {
+                return bad("guess_window needs positive xy and theta and a non-negative share");
+            }
+        }
         Ok(())
+    }
+
+    /// These parameters with the correction bounds for a match from `guess`: the
+    /// fixed ones narrowed by [`IcpParams::guess_window`], when there is one.
+    pub fn around(&self, guess: &odocal_geom::Pose2) -> IcpParams {
+        let Some(w) = self.guess_window else {
+            return self.clone();
+        };
+        IcpParams {
+            max_linear_correction: self
+                .max_linear_correction
+                .min(w.xy + w.share * guess.translation_norm()),
+            max_angular_correction: self
+                .max_angular_correction
+                .min(w.theta + w.share * odocal_geom::wrap_angle(guess.theta).abs()),
+            ..self.clone()
+        }
     }
 }

@@ -24,7 +24,7 @@ use crate::consistency::{check_consistency, robust_spread};
 use crate::correlative::{search, Candidate, Level};
 use crate::covariance::{InformationSum, RayResiduals};
 use crate::free_direction::free_if_corridor;
-use crate::matcher::check_ending;
+use crate::matcher::check_correction;
 use crate::nearest_grid::NearestGrid;
 use crate::neighbourhood_lines::{
     NeighbourhoodLine, NeighbourhoodLines, MATCHING_RADIUS, MAX_POINTS,
@@ -218,6 +218,8 @@ impl Pair<'_> {
         let mut converged = false;
         let mut iterations = 0;
         let mut last_step = (f64::NAN, f64::NAN);
+        let mut last_motion = Pose2::IDENTITY;
+        let settle = (SETTLE_NOISE_SHARE * self.noise).max(params.settle_xy);
         let gate = |iteration: u32| {
             if iteration <= WIDE_ITERATIONS {
                 FINE.gate
@@ -249,12 +251,12 @@ impl Pair<'_> {
             })?;
             let step = pose.between(&next);
             last_step = (step.translation_norm(), step.theta.abs());
+            last_motion = step;
             pose = next;
             let small = last_step.0 <= params.epsilon_xy && last_step.1 <= params.epsilon_theta;
             // Matches flipping between neighbouring lines (whose offsets differ by
             // their noise) move the estimate back and forth: settled once the steps
             // move the points by a small fraction of the noise.
-            let settle = (SETTLE_NOISE_SHARE * self.noise).max(params.settle_xy);
             let settled = iterations >= params.settle_after
                 && last_step.0 <= settle
                 && last_step.1 * self.rms_range <= settle;
@@ -270,7 +272,27 @@ impl Pair<'_> {
             }
             history[iterations as usize % history.len()] = fingerprint;
         }
-        check_ending(anchor, &pose, converged, iterations, last_step, params)?;
+        if !converged {
+            // Along a corridor the iterations may slide along the walls without end:
+            // only the directions the scans fix need to have settled.
+            return match self.result(pose, anchor, gate(iterations), iterations, params) {
+                Ok(r)
+                    if settled_across(
+                        &last_motion,
+                        r.result.free_direction,
+                        self.rms_range,
+                        settle,
+                    ) =>
+                {
+                    Ok(r)
+                }
+                _ => Err(IcpError::FailedToConverge {
+                    iterations,
+                    last_step_xy: last_step.0,
+                    last_step_theta: last_step.1,
+                }),
+            };
+        }
         self.result(pose, anchor, gate(iterations), iterations, params)
     }
 
@@ -360,8 +382,30 @@ impl Pair<'_> {
         check_consistency(&result, &sparse)?;
         // Along a corridor: the two directions the scans fix, the third left free.
         let result = free_if_corridor(result, anchor, self.rms_range, params.max_condition_number);
+        // The correction is judged where the result ends: along a corridor, at the
+        // guess (a washboard's minimum far along it says nothing).
+        check_correction(anchor, &result.pose, params)?;
         Ok(Refined { result, cost })
     }
+}
+
+/// Did the last `step` of the iterations move the points by at most `settle` (m)
+/// across a result's `free` direction (a corridor's; see [`free_if_corridor`]),
+/// with rotations scaled by `rho`, the current scan's RMS range? Never for a result
+/// that fixes every direction (`None`).
+fn settled_across(step: &Pose2, free: Option<[f64; 3]>, rho: f64, settle: f64) -> bool {
+    let Some(d) = free else {
+        return false;
+    };
+    let s = [step.x, step.y, rho * step.theta];
+    let a = [d[0], d[1], rho * d[2]];
+    let norm = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+    if norm.is_nan() || norm <= 0.0 {
+        return false;
+    }
+    let along = (s[0] * a[0] + s[1] * a[1] + s[2] * a[2]) / norm;
+    let across2 = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]) - along * along;
+    across2.max(0.0).sqrt() <= settle
 }
 
 /// A consistent result and how well it explains the scans.
@@ -711,6 +755,71 @@ mod tests {
             Ok(r) if !r.ill_conditioned => free_along_x(&r, &a.between(&b), 0.0),
             _ => {}
         }
+    }
+
+    /// With a guess window ([`crate::IcpParams::guess_window`]) the search stays
+    /// within it: a match 12 cm from a guess allowed 5 cm is refused, not found; a
+    /// window that grows with the guess to cover it finds it exactly. Along a
+    /// corridor the free direction is not judged against the window: the result
+    /// is at the guess there, whatever the washboard's minimum.
+    #[test]
+    fn a_guess_window_keeps_the_search_near_the_guess() {
+        let window = |xy: f64, share: f64| IcpParams {
+            guess_window: Some(crate::GuessWindow {
+                xy,
+                theta: 0.05,
+                share,
+            }),
+            ..IcpParams::default()
+        };
+        let walls = room();
+        let (a, b) = (Pose2::new(0.1, -0.2, 0.3), Pose2::new(0.3, -0.05, 0.32));
+        let reference = prepare(&scan(&walls, &a, 2, 0), &IcpParams::default());
+        let current = prepare(&scan(&walls, &b, 2, 1), &IcpParams::default());
+        let truth = a.between(&b);
+        // About 13 cm guessed, 12 cm short.
+        let guess = Pose2::new(truth.x - 0.12, truth.y, truth.theta);
+        let run = |params: IcpParams| {
+            crate::Matcher::new(params).match_scans(&reference, &current, guess)
+        };
+        let wide = run(IcpParams::default()).unwrap();
+        let e = truth.between(&wide.pose);
+        assert!(e.translation_norm() < 1e-5 && e.theta.abs() < 1e-5, "{e}");
+        let narrow = run(window(0.05, 0.0));
+        assert!(
+            matches!(narrow, Err(IcpError::CorrectionTooLarge { .. })),
+            "{narrow:?}"
+        );
+        // 5 cm and all of the guessed displacement: wide enough.
+        let grown = run(window(0.05, 1.0)).unwrap();
+        let e = truth.between(&grown.pose);
+        assert!(e.translation_norm() < 1e-5 && e.theta.abs() < 1e-5, "{e}");
+        // A corridor: guessed 25 cm along it from the truth, 2 cm across.
+        let walls = vec![([-60.0, -1.0], [60.0, -1.0]), ([-60.0, 1.2], [60.0, 1.2])];
+        let (a, b) = (Pose2::new(0.0, 0.0, 0.0), Pose2::new(0.1, 0.02, 0.03));
+        let reference = prepare(&scan(&walls, &a, 3, 0), &IcpParams::default());
+        let current = prepare(&scan(&walls, &b, 3, 1), &IcpParams::default());
+        let guess = Pose2::new(0.35, 0.0, 0.0);
+        let r = crate::Matcher::new(window(0.05, 0.0))
+            .match_scans(&reference, &current, guess)
+            .unwrap();
+        free_along_x(&r, &a.between(&b), guess.x);
+    }
+
+    /// The iterations along a corridor count as settled when their last step moved
+    /// the points along the free direction only.
+    #[test]
+    fn steps_along_the_free_direction_only_are_settled() {
+        let free = Some([1.0, 0.0, 0.0]);
+        let along = Pose2::new(0.3, 0.0, 0.0);
+        let across = Pose2::new(0.3, 0.002, 0.0);
+        let turned = Pose2::new(0.0, 0.0, 0.001);
+        assert!(settled_across(&along, free, 2.0, 1e-3));
+        assert!(!settled_across(&across, free, 2.0, 1e-3));
+        // 1 mrad at 2 m moves the points 2 mm.
+        assert!(!settled_across(&turned, free, 2.0, 1e-3));
+        assert!(settled_across(&turned, free, 2.0, 3e-3));
+        assert!(!settled_across(&along, None, 2.0, 1e-3));
     }
 
     #[test]

@@ -90,12 +90,27 @@ fn mismatched_inputs_and_nan_guess_are_errors() {
 
     let bad = IcpParams {
         trim_fraction: 0.0,
-        ..params
+        ..params.clone()
     };
     let err = Matcher::new(bad)
         .match_scans(&scan, &scan, Pose2::IDENTITY)
         .unwrap_err();
     assert!(matches!(err, IcpError::InvalidParams(_)), "{err}");
+
+    for window in [(f64::NAN, 0.05, 0.2), (0.05, 0.0, 0.2), (0.05, 0.05, -1.0)] {
+        let bad = IcpParams {
+            guess_window: Some(odocal_icp::GuessWindow {
+                xy: window.0,
+                theta: window.1,
+                share: window.2,
+            }),
+            ..params.clone()
+        };
+        let err = Matcher::new(bad)
+            .match_scans(&scan, &scan, Pose2::IDENTITY)
+            .unwrap_err();
+        assert!(err.to_string().contains("guess_window"), "{err}");
+    }
 }
 
 #[test]

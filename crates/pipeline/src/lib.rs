@@ -38,6 +38,7 @@ pub mod consistency;
 mod error;
 pub mod estimate;
 pub mod finding;
+pub mod guess_window;
 pub mod health;
 pub mod input_files;
 pub mod joint;

@@ -7,12 +7,14 @@
 //! explained). The scans just before and just after see the same walls at other rays.
 //! So a refused pair `(a, b)` of sparse scans is matched again as two point clouds:
 //! scan `a` with the [`NEIGHBOURS`] scan before it placed in its frame, and scan `b`
-//! with the one after it placed in its frame. The scans between the two are left
-//! out, so that no scan is in both clouds and no odometry over the pair's own
-//! interval enters its match. The neighbours are placed by odometry with the current
-//! estimate over one scan period; the pair keeps its own interval and its own wheel
-//! motion. The match must explain a share of the second scan's own points, not of
-//! its neighbour's ([`PreparedScan::from_points`]).
+//! with the one after it placed in its frame; a scan of few returns takes the next
+//! one too, up to [`MAX_NEIGHBOURS`] ([`CLOUD_POINTS`]), and a scan of fewer returns
+//! than a scan matched alone needs is matched in its cloud ([`MIN_OWN_POINTS`]). The
+//! scans between the two are left out, so that no scan is in both clouds and no
+//! odometry over the pair's own interval enters its match. The neighbours are placed
+//! by odometry with the current estimate over one or two scan periods; the pair
+//! keeps its own interval and its own wheel motion. The match must explain a share of
+//! the second scan's own points, not of its neighbours' ([`PreparedScan::from_points`]).
 //!
 //! What this costs in honesty: the placement carries the odometry's error over that
 //! period, which the match's covariance does not hold, and it pulls the match toward
@@ -36,25 +38,48 @@ use rayon::prelude::*;
 use std::borrow::Cow;
 use std::collections::{BTreeSet, HashMap};
 
-/// Scans merged into each scan of a refused pair: the one before the first scan, the
-/// one after the second (one scan period of odometry each). Two each matched 2 % more
-/// of the simulated Neato's pairs, but on the real MinesRover logs thinned to a
-/// Neato-like scan (a skid-steer that slips in turns) they agreed worse with the
-/// full logs than one each, and than without the stage (docs/benchmarks.md, stop 37).
+/// Scans merged into each scan of a refused pair at least: the one before the first
+/// scan, the one after the second (one scan period of odometry each). Two each
+/// matched 2 % more of the simulated Neato's pairs, but on the real MinesRover logs
+/// thinned to a Neato-like scan (a skid-steer that slips in turns) they agreed worse
+/// with the full logs than one each, and than without the stage (docs/benchmarks.md,
+/// stop 37).
 pub const NEIGHBOURS: usize = 1;
+
+/// Scans merged into each scan of a refused pair at most: a cloud takes the next
+/// scan beyond it while it holds fewer than [`CLOUD_POINTS`] points. A scan of 20–30
+/// returns (the Neato in open or dark rooms) is too sparse with one neighbour. Up to
+/// four a side matched 1 % more of the simulated Neato's pairs than two, but clouds of
+/// three or four neighbours a side were 5–22 mm off along the motion (the placement's
+/// odometry error), and ℓx's calibration error on 30 logs went to 1.08σ RMS with two
+/// values beyond 3σ (docs/benchmarks.md, stop 40).
+pub const MAX_NEIGHBOURS: usize = 2;
+
+/// Points a cloud holds before it takes another neighbour: with its 40 % share of its
+/// own points and 20 correspondences, a cloud of fewer is rarely matched. A scan of 30
+/// returns or more (the Neato's usual 40–80, the thinned real logs') takes its one
+/// neighbour only: at 80 points the thinned real logs took a second one, gained no
+/// samples and agreed worse with their full logs.
+pub const CLOUD_POINTS: usize = 60;
+
+/// Valid readings a scan of a refused pair needs here (the matcher asks
+/// [`IcpParams::min_valid_points`] of a scan matched alone): a scan of 10 to 19
+/// returns, refused alone, is matched with the neighbours that make its cloud.
+pub const MIN_OWN_POINTS: usize = 10;
 
 /// Whether a pair of sparse scans refused for `failure` is worth matching with its
 /// neighbouring scans: refusals for too few points in common (too few
-/// correspondences, too small a share of the current scan explained), which more
-/// points cure. Not an unusable scan, nor a displacement the walls do not constrain
-/// (a corridor stays one with more points along it: of the Neato's pairs refused as
-/// ill-conditioned, 17 % were matched with their neighbours, at the cost of a full
-/// correlative search each), nor ambiguity or iterations that did not settle (4 of
-/// 45).
+/// correspondences, too small a share of the current scan explained) or in a scan
+/// (fewer valid readings than a scan matched alone needs), which more points cure; a
+/// scan that cannot be read at all stays refused when the stage prepares it. Not a
+/// displacement the walls do not constrain (a corridor stays one with more points
+/// along it: of the Neato's pairs refused as ill-conditioned, 17 % were matched with
+/// their neighbours, at the cost of a full correlative search each), nor ambiguity or
+/// iterations that did not settle (4 of 45).
 pub fn worth_densifying(failure: &MatchFailure) -> bool {
     matches!(
         failure.reason,
-        Rejection::Correspondences | Rejection::Overlap
+        Rejection::Correspondences | Rejection::Overlap | Rejection::Scan
     )
 }
 
@@ -74,9 +99,10 @@ fn prepare_all(
         .collect()
 }
 
-/// The points of scan `anchor` and of those of `neighbours` odometry can place in its
-/// frame, and how many those are; `None` when the anchor is unusable or the cloud
-/// cannot be prepared.
+/// The points of scan `anchor` and of those of `neighbours` (nearest first)
+/// odometry can place in its frame, and how many those are; `None` when the anchor is
+/// unusable or the cloud cannot be prepared. It takes at least [`NEIGHBOURS`] of
+/// them, then more while it holds fewer than [`CLOUD_POINTS`] points.
 fn cloud(
     source: &LinkSource<'_>,
     predictor: &Predictor,
@@ -88,7 +114,10 @@ fn cloud(
     let own = prepared.get(&anchor)?.points();
     let mut placed_points = Vec::new();
     let mut placed = 0;
-    for n in neighbours {
+    for (taken, n) in neighbours.enumerate() {
+        if taken >= NEIGHBOURS && own.len() + placed_points.len() >= CLOUD_POINTS {
+            break;
+        }
         let (Some(scan), Some(pose)) = (prepared.get(&n), source.odometry(predictor, anchor, n))
         else {
             continue;
@@ -134,11 +163,17 @@ pub fn rescue_with_neighbours(
     if refused.is_empty() {
         return;
     }
+    // Every scan of the stage is prepared with as few as MIN_OWN_POINTS returns; the
+    // clouds and their matches ask what `params` ask.
+    let scan_params = IcpParams {
+        min_valid_points: params.min_valid_points.min(MIN_OWN_POINTS),
+        ..params.clone()
+    };
     // The pairs' own scans (compensated already when the sweep is): is one sparse?
     let own = prepare_all(
         scans,
         refused.iter().flat_map(|&k| [pairs[k].0, pairs[k].1]),
-        params,
+        &scan_params,
     );
     let sparse = |i: usize| own.get(&i).is_some_and(|s| s.is_sparse(params));
     let refused: Vec<usize> = refused
@@ -149,8 +184,9 @@ pub fn rescue_with_neighbours(
         return;
     }
     let count = source.scans.len();
-    let reference_side = |a: usize| a.saturating_sub(NEIGHBOURS)..a;
-    let current_side = move |b: usize| (b + 1)..(b + 1 + NEIGHBOURS).min(count);
+    // Nearest first.
+    let reference_side = |a: usize| (a.saturating_sub(MAX_NEIGHBOURS)..a).rev();
+    let current_side = move |b: usize| (b + 1)..(b + 1 + MAX_NEIGHBOURS).min(count);
     let mut neighbours: BTreeSet<usize> = refused
         .iter()
         .flat_map(|&k| reference_side(pairs[k].0).chain(current_side(pairs[k].1)))
@@ -172,7 +208,7 @@ pub fn rescue_with_neighbours(
             )
         });
     }
-    let mut prepared = prepare_all(scans, neighbours.into_iter(), params);
+    let mut prepared = prepare_all(scans, neighbours.into_iter(), &scan_params);
     prepared.extend(own);
     let predictor = Predictor::new(estimate, source.use_profile);
     let rescued: Vec<Option<MatchStats>> = refused

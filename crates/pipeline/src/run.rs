@@ -366,16 +366,19 @@ fn rescue(
     rescue_with_neighbours(links, scans, compensated, pairs, results, icp);
 }
 
-/// Matches the samples again with first guesses from `params` — and, when the scans
-/// were swept, after compensating the sweep with `params` (samples whose sweeps the
+/// Matches the samples again with first guesses from `first`'s estimate, within the
+/// window its residuals allow ([`crate::guess_window`]) — and, when the scans were
+/// swept, after compensating the sweep with that estimate (samples whose sweeps the
 /// encoders do not cover are discarded as encoder gaps).
 fn second_pass(
     log: &Log,
     synced: &mut Synchronized,
-    params: &Params,
+    first: &Calibration,
     opts: &Options,
     progress: &dyn Progress,
 ) {
+    let params = &first.params;
+    let window = crate::guess_window::second_pass(first.sm_sigma);
     let motions: Vec<(usize, WheelMotion)> = synced
         .samples
         .iter()
@@ -405,7 +408,12 @@ fn second_pass(
         (Cow::Borrowed(&log.scans), vec![true; index_pairs.len()])
     };
     let matcher = opts.icp_for(log);
-    let icp = with_typical_noise(&matcher, typical_noise_sigma(&scans, &matcher));
+    // The guesses are odometry with an estimate solved from the log: a match far
+    // beyond their error is one the solver would trim (crate::guess_window).
+    let icp = IcpParams {
+        guess_window: window,
+        ..with_typical_noise(&matcher, typical_noise_sigma(&scans, &matcher))
+    };
     progress.start("matching (second pass)", index_pairs.len());
     let mut matched: Vec<Result<MatchStats, MatchFailure>> =
         match_pairs(&scans, &index_pairs, &guesses, &icp, || progress.advance());
@@ -716,7 +724,7 @@ pub fn calibrate_log(
         };
         timing.solve += t_solve.elapsed().as_secs_f64();
         let t = Instant::now();
-        second_pass(log, &mut synced, &first.params, opts, progress);
+        second_pass(log, &mut synced, &first, opts, progress);
         timing.r#match += t.elapsed().as_secs_f64();
         if let (true, Some(est)) = (sweep, offset.as_ref()) {
             // The offset was estimated on scans compensated at the starting offset

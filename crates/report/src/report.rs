@@ -56,7 +56,7 @@ pub struct Report {
     /// `odocal_pipeline::chained`), among the samples synchronized.
     pub chained_matches: usize,
     /// Pairs of sparse scans refused when matched alone and matched with each scan
-    /// densified by the scan beyond it, placed by odometry (see
+    /// densified by the scan beyond it (or two), placed by odometry (see
     /// `odocal_pipeline::local_map`), among the samples synchronized.
     pub neighbour_matches: usize,
     /// Pairs of sparse scans matched along a corridor, among the samples
@@ -467,12 +467,9 @@ impl fmt::Display for Report {
         if self.neighbour_matches > 0 {
             writeln!(
                 f,
-                "  matched with their neighbouring scans: {} pairs of sparse scans refused when matched alone (each scan densified by {} beyond it, placed by odometry)",
+                "  matched with their neighbouring scans: {} pairs of sparse scans refused when matched alone (each scan densified by the scan beyond it, or the {} beyond it when it has few returns, placed by odometry)",
                 self.neighbour_matches,
-                match odocal_pipeline::local_map::NEIGHBOURS {
-                    1 => "the scan".to_string(),
-                    n => format!("the {n} scans"),
-                }
+                odocal_pipeline::local_map::MAX_NEIGHBOURS
             )?;
         }
         if self.free_direction_matches > 0 {
