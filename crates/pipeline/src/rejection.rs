@@ -70,8 +70,11 @@ impl Rejection {
                  or moving people and clutter): pair closer scans (--stride 1 or 2)"
             }
             Rejection::Correction => {
-                "the first guesses are far from the matches: give the nominal parameters \
-                 (--nominal r_L,r_R,b) so that odometry guesses the motion"
+                "the matches end far from their first guesses: give the nominal parameters \
+                 (--nominal r_L,r_R,b) so that odometry guesses the motion; matched again \
+                 from the first estimate, a match farther from odometry than the log's \
+                 other pairs allow is a wrong alignment or a slip of the wheels (drive \
+                 slower, on a floor that grips)"
             }
             Rejection::Correspondences => {
                 "the scans have too few returns in common (open space, dark or glass \
