@@ -54,6 +54,11 @@ pub struct LinkSource<'a> {
     pub limits: &'a SyncLimits,
     /// The estimate the guesses and the compensation use; `None`: identity guesses.
     pub params: Option<&'a Params>,
+    /// The spread (σ of x, y, θ; m, m, rad) of the residuals `ŝ_pred − ŝ` of the solve
+    /// that made `params`, over a pair's interval
+    /// ([`odocal_solver::Calibration::sm_sigma`]): how wrong odometry with it is, at
+    /// most. `None`: not known (a nominal given by hand, no estimate).
+    pub residual_sigma: Option<[f64; 3]>,
     /// Guess with the encoder profile (non-constant speeds).
     pub use_profile: bool,
     /// Laser clock minus encoder clock (s).
@@ -340,6 +345,7 @@ mod tests {
             track: &track,
             limits: &limits,
             params: Some(&params),
+            residual_sigma: None,
             use_profile: true,
             time_offset: 0.0,
         };

@@ -194,6 +194,7 @@ pub fn synchronize_and_match(
     progress.start("matching", index_pairs.len());
     let mut matched: Vec<Option<Result<MatchStats, MatchFailure>>> = vec![None; kept.len()];
     let mut guess_params = opts.initial_params;
+    let mut guess_sigma = None;
     let bootstrap = (opts.bootstrap_guesses || sweep) && kept.len() >= MIN_SAMPLES;
     // The log's typical range noise, estimated once for every match of its scans.
     let matcher = opts.icp_for(log);
@@ -242,10 +243,11 @@ pub fn synchronize_and_match(
             accept_weak: true,
             ..opts.solve_options()
         };
-        guess_params = odocal_solver::calibrate(&samples, &rough)
+        let rough_fit = odocal_solver::calibrate(&samples, &rough)
             .ok()
-            .map(|c| c.params)
-            .filter(|p| p.r_l > 0.0 && p.r_r > 0.0 && p.b > 0.0);
+            .filter(|c| c.params.r_l > 0.0 && c.params.r_r > 0.0 && c.params.b > 0.0);
+        guess_sigma = rough_fit.as_ref().map(|c| c.sm_sigma);
+        guess_params = rough_fit.map(|c| c.params);
         for (i, r) in subset.into_iter().zip(results) {
             // A failure is matched again from the odometry guess when there is one.
             if r.is_ok() || guess_params.is_none() {
@@ -298,6 +300,7 @@ pub fn synchronize_and_match(
         track: &track,
         limits: &limits,
         params: guess_params.as_ref(),
+        residual_sigma: guess_sigma,
         use_profile: opts.use_profile,
         time_offset: opts.time_offset,
     };
@@ -424,6 +427,7 @@ fn second_pass(
         track: &track,
         limits: &synced.limits,
         params: Some(params),
+        residual_sigma: Some(first.sm_sigma),
         use_profile: opts.use_profile,
         time_offset: synced.time_offset,
     };
