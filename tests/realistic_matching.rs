@@ -121,10 +121,7 @@ impl Yield {
 
     /// Accepted matches beyond 5 mm or 0.5° of the truth.
     fn wrong(&self) -> usize {
-        self.errors
-            .iter()
-            .filter(|(d, a)| *d > MAX_ERROR_M || *a > MAX_ERROR_RAD)
-            .count()
+        self.errors.iter().filter(|e| beyond(e)).count()
     }
 
     /// Accepted matches beyond 5 mm or 0.5° of the truth whose own covariance does not
@@ -133,7 +130,7 @@ impl Yield {
         self.errors
             .iter()
             .zip(&self.nees)
-            .filter(|((d, a), n)| (*d > MAX_ERROR_M || *a > MAX_ERROR_RAD) && **n > NEES_997)
+            .filter(|(e, n)| beyond(e) && **n > NEES_997)
             .count()
     }
 
@@ -145,7 +142,7 @@ impl Yield {
             .errors
             .iter()
             .zip(&self.chained)
-            .filter(|((d, a), c)| **c && (*d > MAX_ERROR_M || *a > MAX_ERROR_RAD))
+            .filter(|(e, c)| **c && beyond(e))
             .count();
         (chained, wrong)
     }
@@ -155,7 +152,7 @@ impl Yield {
     /// beyond.
     fn neighboured_wrong(&self) -> (usize, usize, f64) {
         let mut out = (0, 0, 0.0);
-        for (((d, a), n), p) in self
+        for ((e, n), p) in self
             .errors
             .iter()
             .zip(&self.neighboured)
@@ -163,7 +160,7 @@ impl Yield {
         {
             if *n > 0 {
                 out.0 += 1;
-                out.1 += usize::from(*d > MAX_ERROR_M || *a > MAX_ERROR_RAD);
+                out.1 += usize::from(beyond(e));
                 out.2 += p;
             }
         }
@@ -253,10 +250,15 @@ impl Yield {
             worst(&self.final_errors).1.to_degrees(),
             self.final_errors
                 .iter()
-                .filter(|(d, a)| *d > MAX_ERROR_M || *a > MAX_ERROR_RAD)
+                .filter(|e| beyond(e))
                 .count(),
         )
     }
+}
+
+/// Is the error `(distance, angle)` (m, rad) beyond 5 mm or 0.5°?
+fn beyond(&(d, a): &(f64, f64)) -> bool {
+    d > MAX_ERROR_M || a > MAX_ERROR_RAD
 }
 
 /// The largest distance and the largest angle of `errors` (m, rad; 0 when empty).

@@ -33,7 +33,7 @@ use crate::chained::LinkSource;
 use crate::matching::{prepare_scan, MatchStats};
 use crate::rejection::{MatchFailure, Rejection};
 use crate::sweep::compensate_into;
-use odocal_icp::{IcpParams, Matcher, PreparedScan};
+use odocal_icp::{IcpParams, IcpResult, Matcher, PreparedScan};
 use odocal_log::ScanStore;
 use odocal_solver::Predictor;
 use rayon::prelude::*;
@@ -83,6 +83,22 @@ pub fn worth_densifying(failure: &MatchFailure) -> bool {
         failure.reason,
         Rejection::Correspondences | Rejection::Overlap | Rejection::Scan
     )
+}
+
+/// The shares of a cloud's match `r` that rest on placed points (reference side,
+/// current side), in [0, 1]: of the reference cloud's `reference_points`, those that
+/// are not its scan's `reference_own`; of the current cloud's correspondences used,
+/// those that are not its scan's own (`matched_share` of its `current_own` points).
+fn placed_shares(
+    r: &IcpResult,
+    reference_own: usize,
+    reference_points: usize,
+    current_own: usize,
+) -> (f64, f64) {
+    let reference = 1.0 - reference_own as f64 / reference_points.max(1) as f64;
+    let own_used = r.matched_share * current_own as f64;
+    let current = 1.0 - own_used / r.correspondences.max(1) as f64;
+    (reference.clamp(0.0, 1.0), current.clamp(0.0, 1.0))
 }
 
 /// The covariance a cloud's match gets from its neighbours' placement: each side's
@@ -281,25 +297,18 @@ pub fn rescue_with_neighbours(
                 ..MatchStats::of(&r)
             };
             if let Some(sigma) = source.residual_sigma {
-                // The shares of the match resting on placed points: of the current
-                // cloud's correspondences used (its own ones are `matched_share` of
-                // its own points), of the reference cloud's points.
-                let points = |i: usize| prepared.get(&i).map_or(0, |s| s.points().len()) as f64;
-                let own_used = r.matched_share * points(b);
-                let current_share = 1.0 - own_used / r.correspondences.max(1) as f64;
-                let reference_share = 1.0 - points(a) / reference.valid_count().max(1) as f64;
+                let points = |i: usize| prepared.get(&i).map_or(0, |s| s.points().len());
+                let (reference_share, current_share) =
+                    placed_shares(&r, points(a), reference.valid_count(), points(b));
                 let add = placement_covariance(
                     sigma,
                     b.saturating_sub(a).max(1),
-                    (before, reference_share.clamp(0.0, 1.0)),
-                    (after, current_share.clamp(0.0, 1.0)),
+                    (before, reference_share),
+                    (after, current_share),
                     r.pose.theta,
                 );
-                for (row, add) in stats.covariance.iter_mut().zip(add) {
-                    for (v, a) in row.iter_mut().zip(add) {
-                        *v += a;
-                    }
-                }
+                let cells = stats.covariance.iter_mut().flatten();
+                cells.zip(add.iter().flatten()).for_each(|(v, a)| *v += a);
             }
             Some(stats)
         })
