@@ -93,6 +93,7 @@ mod correlative;
 mod correspondence;
 mod cost_envelope;
 mod covariance;
+mod depth_edges;
 mod error;
 mod free_direction;
 mod matcher;
