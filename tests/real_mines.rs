@@ -23,11 +23,8 @@ fn most_pairs_of_the_real_mines_logs_match_and_every_refusal_has_its_reason() {
     // its truth (one spin decided it: now caught by the one-sample rule of the solver).
     // 163/174 (94 %) and 121/147 (82 %) since runs go across up to two readings
     // without a return (IcpParams::bridged_missing_rays; docs/benchmarks.md).
-    // Issue 20's target (80 %) is met on both. 156/174 (90 %, just under) and
-    // 120/147 (82 %) since the readings at depth edges are left out (mixed pixels;
-    // odocal_icp::depth_edges): the two logs agree better, exp1 keeps 6 samples
-    // fewer and exp2 5 more after the trimming.
-    for (name, min_yield) in [("exp1.log", 0.85), ("exp2.log", 0.80)] {
+    // Issue 20's target (80 %) is met on both.
+    for (name, min_yield) in [("exp1.log", 0.90), ("exp2.log", 0.80)] {
         let Some(path) = mines_log(name) else { return };
         let log = odocal_log::read_log(&path, &Default::default()).unwrap();
         let opts = Options {

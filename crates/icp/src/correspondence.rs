@@ -172,15 +172,6 @@ mod tests {
     /// (0: no return), or replaced by `jump` (m: a far surface); the first 40 and the
     /// last 50 rays got no return either (a sparse scan: missing returns are common).
     fn wall_with_gap(gap: std::ops::Range<usize>, jump: Option<f32>) -> PreparedScan {
-        wall_with_gap_prepared(gap, jump, &IcpParams::default())
-    }
-
-    /// [`wall_with_gap`] prepared with `params`.
-    fn wall_with_gap_prepared(
-        gap: std::ops::Range<usize>,
-        jump: Option<f32>,
-        params: &IcpParams,
-    ) -> PreparedScan {
         let angles: Vec<f64> = (0..181)
             .map(|i| (45.0 + i as f64 * 0.5).to_radians())
             .collect();
@@ -194,7 +185,7 @@ mod tests {
                 (true, Some(far)) => far,
             })
             .collect();
-        PreparedScan::new(&ranges, &angles, 0.02, 5.6, params).expect("scan")
+        PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).expect("scan")
     }
 
     /// The point on the wall at x, and the closest reference point to it (its index
@@ -267,22 +258,10 @@ mod tests {
         // The same wall, rays 90..100 seeing a far surface instead: an occlusion edge,
         // whether the far readings are valid (3.5 m) or beyond the scan's maximum
         // range (6 m, above its 5.6 m).
-        // The wall's last reading before a valid far one is left out as a depth
-        // edge's (crate::depth_edges) unless edges are kept: the run then ends one
-        // ray earlier, and is not followed either.
-        let kept = IcpParams {
-            depth_edge_min_jump: f64::INFINITY,
-            ..IcpParams::default()
-        };
-        for (far, params, last) in [
-            (3.5, &kept, 89),
-            (6.0, &kept, 89),
-            (3.5, &IcpParams::default(), 88),
-            (6.0, &IcpParams::default(), 89),
-        ] {
-            let scan = wall_with_gap_prepared(90..100, Some(far), params);
+        for far in [3.5, 6.0] {
+            let scan = wall_with_gap(90..100, Some(far));
             let (p, j) = on_wall(&scan, -0.008);
-            assert_eq!(scan.original[j], last, "{far}");
+            assert_eq!(scan.original[j], 89, "{far}");
             assert_eq!(segment_for(&scan, p, j), None, "{far}");
         }
     }

@@ -2,11 +2,9 @@
 //! two scans, with its covariance.
 //!
 //! The pipeline, one small step per module:
-//! 1. [`PreparedScan::new`] (module `preprocess`): the valid readings → points (both
-//!    readings of each depth edge left out of scans of fine rays, module
-//!    `depth_edges`: one may be a mixed pixel), runs without range discontinuities
-//!    (across up to [`IcpParams::bridged_missing_rays`] readings without a return),
-//!    and for every
+//! 1. [`PreparedScan::new`] (module `preprocess`): the valid readings → points, runs
+//!    without range discontinuities (across up to
+//!    [`IcpParams::bridged_missing_rays`] readings without a return), and for every
 //!    segment between consecutive points a *local line* (total least squares over
 //!    the best-fitting window of `line_fit_window` run points containing it); the
 //!    scan's range noise from those windows, or from lines through metric
@@ -95,7 +93,6 @@ mod correlative;
 mod correspondence;
 mod cost_envelope;
 mod covariance;
-mod depth_edges;
 mod error;
 mod free_direction;
 mod matcher;

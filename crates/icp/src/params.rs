@@ -79,19 +79,6 @@ pub struct IcpParams {
     pub discontinuity_min_gap: f64,
     /// … see [`IcpParams::discontinuity_min_gap`].
     pub discontinuity_gap_factor: f64,
-    /// Both readings of two neighbouring rays whose ranges differ by more than
-    /// `max(depth_edge_min_jump, depth_edge_jump_factor · range · Δangle)` (m) are
-    /// left out of a scan (not of a cloud, [`crate::PreparedScan::from_points`]): one
-    /// of them may be a mixed pixel, a range between the two surfaces (see the module
-    /// `depth_edges`). 5 cm by default; infinity keeps every reading.
-    pub depth_edge_min_jump: f64,
-    /// … see [`IcpParams::depth_edge_min_jump`]; 3 by default (the steps of a surface
-    /// seen beyond atan 3 ≈ 72° of incidence are jumps).
-    pub depth_edge_jump_factor: f64,
-    /// … only in scans whose rays are at most this far apart (rad; 0.6° by default):
-    /// on coarser rays an edge's two readings are too large a share of a surface's
-    /// few (a 1° laser's corners are what its matches hold on to).
-    pub depth_edge_max_ray_step: f64,
     /// Two valid points with up to this many readings without a return between them
     /// (zero, NaN or at most the minimum range: dropouts, dark or glancing spots) are
     /// consecutive points of one run, on one surface when the gap test above holds
@@ -191,9 +178,6 @@ impl Default for IcpParams {
             max_line_fit_rms: 0.01,
             discontinuity_min_gap: 0.05,
             discontinuity_gap_factor: 10.0,
-            depth_edge_min_jump: 0.05,
-            depth_edge_jump_factor: 3.0,
-            depth_edge_max_ray_step: 0.6f64.to_radians(),
             bridged_missing_rays: 2,
             min_valid_points: 20,
             min_correspondences: 20,
@@ -254,17 +238,6 @@ impl IcpParams {
         }
         if !positive(self.discontinuity_min_gap) || !positive(self.discontinuity_gap_factor) {
             return bad("discontinuity_min_gap and discontinuity_gap_factor must be positive");
-        }
-        if !(self.depth_edge_min_jump > 0.0
-            && self.depth_edge_jump_factor >= 0.0
-            && self.depth_edge_jump_factor.is_finite()
-            && self.depth_edge_max_ray_step >= 0.0)
-        {
-            return bad(
-                "depth_edge_min_jump must be positive (infinity: keep every reading), \
-                 depth_edge_jump_factor finite and at least 0, and depth_edge_max_ray_step \
-                 at least 0",
-            );
         }
         if self.min_valid_points < 3 || self.min_correspondences < 3 {
             return bad("min_valid_points and min_correspondences must be at least 3");

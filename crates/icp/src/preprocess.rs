@@ -139,28 +139,12 @@ impl PreparedScan {
     /// `params.min_reading`, and below both `max_range` and `params.max_reading`.
     /// Errors: arrays of different lengths, non-finite angles, invalid parameters, or
     /// fewer than `params.min_valid_points` valid readings.
-    ///
-    /// The readings on either side of a depth edge are left out when the rays are
-    /// fine enough (see [`IcpParams::depth_edge_min_jump`]).
     pub fn new(
         ranges: &[f32],
         angles: &[f64],
         min_range: f64,
         max_range: f64,
         params: &IcpParams,
-    ) -> Result<PreparedScan, IcpError> {
-        Self::prepare(ranges, angles, min_range, max_range, params, true)
-    }
-
-    /// [`PreparedScan::new`]; with `drop_depth_edges` false (a cloud, whose
-    /// neighbouring entries are not neighbouring rays) every valid reading is kept.
-    fn prepare(
-        ranges: &[f32],
-        angles: &[f64],
-        min_range: f64,
-        max_range: f64,
-        params: &IcpParams,
-        drop_depth_edges: bool,
     ) -> Result<PreparedScan, IcpError> {
         params.validate()?;
         if ranges.len() != angles.len() {
@@ -186,20 +170,6 @@ impl PreparedScan {
         let hi = max_range.min(params.max_reading);
         let ray_step = mean_step(angles);
         let no_return = no_returns(ranges, lo);
-        // Readings at depth edges count as readings without a return from here on:
-        // runs bridge them, edges still break runs (crate::depth_edges).
-        let without_edges: Vec<f32>;
-        let ranges = if drop_depth_edges && ray_step <= params.depth_edge_max_ray_step {
-            let edge = crate::depth_edges::depth_edge_readings(ranges, angles, lo, hi, params);
-            without_edges = ranges
-                .iter()
-                .zip(&edge)
-                .map(|(&r, &e)| if e { 0.0 } else { r })
-                .collect();
-            &without_edges[..]
-        } else {
-            ranges
-        };
         let (original, bridgeable) = kept_readings(ranges, lo, hi, params.bridged_missing_rays);
         let kept_ranges: Vec<f32> = original.iter().map(|&i| ranges[i as usize]).collect();
         let kept_angles: Vec<f64> = original.iter().map(|&i| angles[i as usize]).collect();
@@ -344,7 +314,7 @@ impl PreparedScan {
         polar.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
         let angles: Vec<f64> = polar.iter().map(|p| p.0).collect();
         let ranges: Vec<f32> = polar.iter().map(|p| p.1).collect();
-        let mut cloud = PreparedScan::prepare(&ranges, &angles, 0.0, f64::INFINITY, params, false)?;
+        let mut cloud = PreparedScan::new(&ranges, &angles, 0.0, f64::INFINITY, params)?;
         cloud.cloud = true;
         cloud.placed = polar.iter().map(|p| p.2).collect();
         Ok(cloud)
@@ -918,12 +888,7 @@ mod tests {
             let angles: Vec<f64> = (0..n).map(|i| -3.1 + 6.2 * i as f64 / n as f64).collect();
             let mut rng = rand::rngs::StdRng::seed_from_u64(5);
             let ranges: Vec<f32> = (0..n).map(|_| rng.random_range(0.5..3.5)).collect();
-            // Every reading here is at a depth edge: kept, to have them all.
-            let params = IcpParams {
-                depth_edge_min_jump: f64::INFINITY,
-                ..IcpParams::default()
-            };
-            PreparedScan::new(&ranges, &angles, 0.02, 5.6, &params).unwrap()
+            PreparedScan::new(&ranges, &angles, 0.02, 5.6, &IcpParams::default()).unwrap()
         };
         assert!(clutter(MAX_NEIGHBOURHOOD_NOISE_POINTS)
             .noise_sigma
@@ -943,39 +908,11 @@ mod tests {
             .enumerate()
             .map(|(i, a)| ((if i < 20 { 1.0 } else { 2.0 }) / a.cos()) as f32)
             .collect();
-        // Edges kept, to see the runs split at the jump itself.
-        let kept = IcpParams {
-            depth_edge_min_jump: f64::INFINITY,
-            ..IcpParams::default()
-        };
-        let scan =
-            PreparedScan::new(&ranges, &angles, 0.02, 4.0, &kept).expect("enough valid points");
+        let scan = PreparedScan::new(&ranges, &angles, 0.02, 4.0, &IcpParams::default())
+            .expect("enough valid points");
         assert!(scan.segments[19].is_none(), "no segment across the jump");
         assert!(scan.segments[18].is_some() && scan.segments[20].is_some());
         let far = scan.segments[25].expect("far wall");
         assert!((far.offset + 2.0).abs() < 1e-6, "{far:?}");
-        // Rays 1.4° apart are too coarse for the depth-edge rule: every reading kept.
-        let scan = PreparedScan::new(&ranges, &angles, 0.02, 4.0, &IcpParams::default())
-            .expect("enough valid points");
-        assert_eq!(scan.points.len(), 40);
-        // On finer rays the two readings of the jump are left out (crate::depth_edges),
-        // and the runs still split there.
-        let fine = IcpParams {
-            depth_edge_max_ray_step: 0.03,
-            ..IcpParams::default()
-        };
-        let scan = PreparedScan::new(&ranges, &angles, 0.02, 4.0, &fine).expect("valid points");
-        assert_eq!(scan.points.len(), 38);
-        assert!(!scan.original.contains(&19) && !scan.original.contains(&20));
-        let k = scan.original.iter().position(|&i| i == 18).unwrap();
-        assert!(scan.segments[k].is_none(), "no segment across the jump");
-        // A cloud's entries are not neighbouring rays: it keeps them all.
-        let points: Vec<[f64; 2]> = ranges
-            .iter()
-            .zip(&angles)
-            .map(|(&r, a)| [f64::from(r) * a.cos(), f64::from(r) * a.sin()])
-            .collect();
-        let cloud = PreparedScan::from_points(&points, &[], &IcpParams::default()).unwrap();
-        assert_eq!(cloud.points.len(), 40);
     }
 }

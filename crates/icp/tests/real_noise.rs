@@ -89,12 +89,7 @@ fn scans_without_straight_runs_show_their_noise_through_neighbourhoods() {
         .iter()
         .map(|r| (r + 0.003 * normal.sample()) as f32)
         .collect();
-    // Each surface's two readings at the depth edges kept: a surface of three points
-    // would show no noise at all.
-    let params = IcpParams {
-        depth_edge_min_jump: f64::INFINITY,
-        ..IcpParams::default()
-    };
+    let params = IcpParams::default();
     let current = PreparedScan::new(&noisy, &angles, 0.02, 5.6, &params).unwrap();
     let sigma = current
         .noise_sigma()

@@ -121,10 +121,9 @@ fn all_determined(c: &Calibration) -> bool {
 
 /// The fewest parameters (one, two, else three) that, held, leave every other parameter well
 /// determined, preferring ℓy, ℓx, ℓθ, b, then the radii; empty when none does. Which ones is found
-/// by holding them at the values proposed — from `--nominal`, the usual mounting (ℓy
-/// and ℓθ at 0) — or, for a value left to measure, at the refused estimate (a held
-/// value moves the others' σ: on the real exp2 log, ℓy held at its estimate left ℓx
-/// well determined, held at the proposed 0 it did not).
+/// by holding them at the refused estimate (the σ of the rest barely depend on the
+/// held value); the values proposed come from `--nominal`, the usual mounting (ℓy and
+/// ℓθ at 0), or are left to measure.
 pub fn holds(
     samples: &[Sample],
     options: &SolveOptions,
@@ -154,9 +153,7 @@ pub fn holds(
         let mut o = *options;
         o.accept_weak = true;
         for &i in set {
-            // At the value the command will hold it at, where one is proposed.
-            let value = known_value(i, nominal).0.unwrap_or(estimate[i]);
-            o.constraints.0[i] = Constraint::Held(value);
+            o.constraints.0[i] = Constraint::Held(estimate[i]);
         }
         odocal_solver::calibrate(samples, &o).is_ok_and(|mut c| {
             // With a margin: the command proposed is run on data matched anew with
