@@ -277,7 +277,7 @@ pub fn compose(links: &[MatchStats]) -> Option<MatchStats> {
 }
 
 /// `J Σ Jᵀ`.
-fn congruence(j: &[[f64; 3]; 3], sigma: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+pub(crate) fn congruence(j: &[[f64; 3]; 3], sigma: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
     let mut out = [[0.0; 3]; 3];
     for (r, row) in out.iter_mut().enumerate() {
         for (c, v) in row.iter_mut().enumerate() {

@@ -29,7 +29,7 @@
 //! tried, and only for refusals more points cure ([`worth_densifying`]); a pair whose
 //! own scans cannot be prepared is left refused.
 
-use crate::chained::LinkSource;
+use crate::chained::{congruence, LinkSource};
 use crate::matching::{prepare_scan, MatchStats};
 use crate::rejection::{MatchFailure, Rejection};
 use crate::sweep::compensate_into;
@@ -119,29 +119,21 @@ fn placement_covariance(
     current: (u32, f64),
     theta: f64,
 ) -> [[f64; 3]; 3] {
-    let mut out = [[0.0; 3]; 3];
     let (s, c) = theta.sin_cos();
-    for ((n, share), turn) in [(reference, false), (current, true)] {
+    let identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    let turn = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+    let mut out = [[0.0; 3]; 3];
+    for ((n, share), into_first) in [(reference, identity), (current, turn)] {
         let k = share * n as f64 / interval as f64;
         let v = sigma.map(|x| (k * x).powi(2));
         if !v.iter().all(|x| x.is_finite()) {
             continue;
         }
-        let (vx, vy) = (v[0], v[1]);
-        let (xx, xy, yy) = if turn {
-            (
-                c * c * vx + s * s * vy,
-                c * s * (vx - vy),
-                s * s * vx + c * c * vy,
-            )
-        } else {
-            (vx, 0.0, vy)
-        };
-        out[0][0] += xx;
-        out[0][1] += xy;
-        out[1][0] += xy;
-        out[1][1] += yy;
-        out[2][2] += v[2];
+        let side = [[v[0], 0.0, 0.0], [0.0, v[1], 0.0], [0.0, 0.0, v[2]]];
+        let cells = out.iter_mut().flatten();
+        cells
+            .zip(congruence(&into_first, &side).iter().flatten())
+            .for_each(|(o, a)| *o += a);
     }
     out
 }
