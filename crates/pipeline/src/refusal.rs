@@ -111,6 +111,13 @@ fn known_value(i: usize, nominal: Option<&Params>) -> (Option<f64>, &'static str
     }
 }
 
+/// The value at which a hold of parameter `i` is tried: the one the printed command
+/// will hold it at ([`known_value`]), or the refused `estimate` for a value the user
+/// is left to measure.
+fn tried_value(i: usize, nominal: Option<&Params>, estimate: &[f64; 6]) -> f64 {
+    known_value(i, nominal).0.unwrap_or(estimate[i])
+}
+
 /// True when every parameter not held is well determined.
 fn all_determined(c: &Calibration) -> bool {
     c.observability
@@ -121,9 +128,10 @@ fn all_determined(c: &Calibration) -> bool {
 
 /// The fewest parameters (one, two, else three) that, held, leave every other parameter well
 /// determined, preferring ℓy, ℓx, ℓθ, b, then the radii; empty when none does. Which ones is found
-/// by holding them at the refused estimate (the σ of the rest barely depend on the
-/// held value); the values proposed come from `--nominal`, the usual mounting (ℓy and
-/// ℓθ at 0), or are left to measure.
+/// by holding them at the values proposed — from `--nominal`, the usual mounting (ℓy
+/// and ℓθ at 0) — or, for a value left to measure, at the refused estimate (a held
+/// value moves the others' σ: on the real exp2 log, ℓy held at its estimate left ℓx
+/// well determined, held at the proposed 0 it did not).
 pub fn holds(
     samples: &[Sample],
     options: &SolveOptions,
@@ -153,7 +161,7 @@ pub fn holds(
         let mut o = *options;
         o.accept_weak = true;
         for &i in set {
-            o.constraints.0[i] = Constraint::Held(estimate[i]);
+            o.constraints.0[i] = Constraint::Held(tried_value(i, nominal, &estimate));
         }
         odocal_solver::calibrate(samples, &o).is_ok_and(|mut c| {
             // With a margin: the command proposed is run on data matched anew with
@@ -192,4 +200,30 @@ pub fn describe_holds(holds: &[Hold]) -> String {
             .join(" and "),
         parts.join(", ")
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn holds_are_tried_at_the_values_the_command_proposes() {
+        // A refused estimate with the laser 4 cm to the left and turned 0.1 rad.
+        let estimate = [0.077, 0.078, 0.31, 0.15, 0.04, 0.1];
+        // Without --nominal: ℓy and ℓθ at the usual mounting (0), not at the
+        // estimate; ℓx and the odometry, left to measure, at the estimate.
+        let tried: Vec<f64> = (0..6).map(|i| tried_value(i, None, &estimate)).collect();
+        assert_eq!(tried, [0.077, 0.078, 0.31, 0.15, 0.0, 0.0]);
+        // With a six-value --nominal, every value is the nominal's.
+        let nominal = Params::from_vector([0.076, 0.076, 0.33, 0.145, 0.001, 0.002]);
+        for (i, want) in nominal.to_vector().iter().enumerate() {
+            assert_eq!(tried_value(i, Some(&nominal), &estimate), *want);
+        }
+        // A three-value --nominal (ℓ all 0) measures the odometry only.
+        let odometry = Params::from_vector([0.076, 0.076, 0.33, 0.0, 0.0, 0.0]);
+        let tried: Vec<f64> = (0..6)
+            .map(|i| tried_value(i, Some(&odometry), &estimate))
+            .collect();
+        assert_eq!(tried, [0.076, 0.076, 0.33, 0.15, 0.0, 0.0]);
+    }
 }
