@@ -11,8 +11,10 @@
 //! - The scans' own noise and tilt estimates lay their disjoint windows from each
 //!   run's first point, so they depend on the order (the real exp1 read the other way:
 //!   another noise estimate in 161 of 188 scans, by up to 20 %).
-//! - The real logs' calibrations are chaotic at about 0.3σ: ranges changed by two
-//!   units in the last place move exp1 by 0.33σ. The bound on them is that floor.
+//! - The real logs' calibrations are chaotic: ranges changed by two units in the
+//!   last place move exp1 by 0.33σ, and by ±1 mm (the URG's quantum) in a fifth of
+//!   the readings by 0.64–0.98σ; exp2's ℓx then takes one of two values (stop 42).
+//!   The bound on them is that floor, and exp2's ℓx is held to its two values.
 //! - The realistic rover is not chaotic (the same change moves it by less than
 //!   0.01σ), and moves 0.13σ with its rays listed the other way: the bound on it.
 
@@ -53,21 +55,41 @@ fn calibrated(log: &Log) -> ([f64; 6], [f64; 6], usize) {
     )
 }
 
-/// Asserts that `log` calibrates to the same parameters with its rays listed either
-/// way: within `share` of their data σ, with at most `samples` samples more or fewer.
-fn same_both_orders(label: &str, log: &Log, share: f64, samples: usize) {
+/// `log`'s calibration with its rays listed as they are and the other way: the two
+/// estimates, how far each parameter moved (in its data σ), and the two sample
+/// counts.
+struct BothOrders {
+    listed: [f64; 6],
+    reversed: [f64; 6],
+    moved: [f64; 6],
+    samples: (usize, usize),
+}
+
+fn both_orders(label: &str, log: &Log) -> BothOrders {
     let (p, sigma, n) = calibrated(log);
     let (q, _, m) = calibrated(&rays_reversed(log));
     println!("{label}: {n} samples, rays listed the other way {m}");
-    let mut worst: f64 = 0.0;
-    for i in 0..6 {
-        let moved = (q[i] - p[i]) / sigma[i];
+    let moved = std::array::from_fn(|i| (q[i] - p[i]) / sigma[i]);
+    for (i, z) in moved.iter().enumerate() {
         println!(
-            "{label} parameter {i}: {:.6} and {:.6} ({moved:+.3} σ)",
+            "{label} parameter {i}: {:.6} and {:.6} ({z:+.3} σ)",
             p[i], q[i]
         );
-        worst = worst.max(moved.abs());
     }
+    BothOrders {
+        listed: p,
+        reversed: q,
+        moved,
+        samples: (n, m),
+    }
+}
+
+/// Asserts that `log` calibrates to the same parameters with its rays listed either
+/// way: within `share` of their data σ, with at most `samples` samples more or fewer.
+fn same_both_orders(label: &str, log: &Log, share: f64, samples: usize) {
+    let b = both_orders(label, log);
+    let worst = b.moved.iter().fold(0.0f64, |w, z| w.max(z.abs()));
+    let (n, m) = b.samples;
     assert!(n.abs_diff(m) <= samples, "{label}: {n} and {m} samples");
     assert!(worst <= share, "{label}: a parameter moved {worst:.3} σ");
 }
@@ -78,6 +100,13 @@ fn a_swept_log_calibrates_the_same_with_its_rays_listed_the_other_way() {
     same_both_orders("mines-rover", &simulated_120s("mines-rover", 8), 0.25, 0);
 }
 
+/// The two values the real exp2 log's ℓx takes (m): the ranges changed by ±1 mm in a
+/// fifth of the readings send it to one or the other, whichever way its rays are
+/// listed (118–132 mm with σ 11–17 mm, or 160–177 mm with σ 21–23 mm, in 14 draws
+/// with and without mixed pixels left out; docs/benchmarks.md, stop 42): which
+/// samples the solve keeps decides it, not the order of the rays.
+const EXP2_L_X_MODES: [std::ops::Range<f64>; 2] = [0.110..0.140, 0.150..0.185];
+
 #[test]
 fn the_real_logs_calibrate_the_same_with_their_rays_listed_the_other_way() {
     for name in ["exp1.log", "exp2.log"] {
@@ -85,9 +114,32 @@ fn the_real_logs_calibrate_the_same_with_their_rays_listed_the_other_way() {
             continue;
         };
         let log = odocal_log::read_log(&path, &Default::default()).unwrap();
-        // Measured: exp1 163 and 160 samples, b −0.32σ, ℓθ −0.33σ; exp2 121 and
-        // 122, ℓy −0.38σ, ℓx −0.31σ. The chaos floor (see the module
-        // documentation) is about 0.33σ.
-        same_both_orders(name, &log, 0.6, 5);
+        // Measured (stop 42, mixed pixels left out): exp1 162 and 160 samples, ℓy
+        // −0.60σ, b +0.39σ; exp2 120 and 122, ℓθ −0.58σ, b −0.25σ, and ℓx from one
+        // of its two values to the other (125 and 170 mm). Before: exp1 163 and 160,
+        // b −0.32σ, ℓθ −0.33σ; exp2 121 and 122, ℓy −0.38σ, ℓx −0.31σ. The chaos
+        // floor is higher than the module documentation's 0.33σ (two units in the
+        // last place): ranges changed by ±1 mm, the URG's quantum, in a fifth of the
+        // readings moved exp1's calibration by 0.64–0.98σ (six draws; stop 42). The
+        // bound is that: 1σ.
+        let b = both_orders(name, &log);
+        let (n, m) = b.samples;
+        assert!(n.abs_diff(m) <= 5, "{name}: {n} and {m} samples");
+        for i in 0..6 {
+            if name == "exp2.log" && i == 3 {
+                for v in [b.listed[i], b.reversed[i]] {
+                    assert!(
+                        EXP2_L_X_MODES.iter().any(|r| r.contains(&v)),
+                        "{name}: l_x {v} in neither of its two values"
+                    );
+                }
+                continue;
+            }
+            assert!(
+                b.moved[i].abs() <= 1.0,
+                "{name}: parameter {i} moved {:.3} σ",
+                b.moved[i]
+            );
+        }
     }
 }

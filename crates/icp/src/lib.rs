@@ -8,8 +8,13 @@
 //!    segment between consecutive points a *local line* (total least squares over
 //!    the best-fitting window of `line_fit_window` run points containing it); the
 //!    scan's range noise from those windows, or from lines through metric
-//!    neighbourhoods when it has too few. Done once per scan, reused as reference or
-//!    current scan.
+//!    neighbourhoods when it has too few. Before that, in scans of rays at most 0.6°
+//!    apart, mixed pixels are left out as readings without a return (module
+//!    `mixed_pixels`: the last reading of a run at a depth edge that lies off the
+//!    run's continuation, towards the surface across the edge, by more than
+//!    [`IcpParams::mixed_pixel_sigmas`] times the log's typical range noise, or the
+//!    scan's own, found by a first preparation). Done once per scan, reused as
+//!    reference or current scan.
 //! 2. `correspondence`: each current point ↔ the segment between its two closest
 //!    consecutive reference points (closest point by CSM's angular walk over the
 //!    ordered rays — the default — or a kiddo k-d tree; no segment across a range
@@ -96,6 +101,7 @@ mod covariance;
 mod error;
 mod free_direction;
 mod matcher;
+mod mixed_pixels;
 mod nearest_grid;
 mod neighbourhood_lines;
 mod params;

@@ -79,6 +79,13 @@ pub struct IcpParams {
     pub discontinuity_min_gap: f64,
     /// … see [`IcpParams::discontinuity_min_gap`].
     pub discontinuity_gap_factor: f64,
+    /// The last reading of a run at a depth edge that lies off the run's
+    /// continuation, towards the surface across the edge, by more than this many
+    /// standard deviations (the range noise, with the continuation's own
+    /// uncertainty) is a mixed pixel, left out of the scan as a reading without a
+    /// return; only in scans of rays at most 0.6° apart (see the crate
+    /// documentation, step 1). 3 by default; infinity keeps every reading.
+    pub mixed_pixel_sigmas: f64,
     /// Two valid points with up to this many readings without a return between them
     /// (zero, NaN or at most the minimum range: dropouts, dark or glancing spots) are
     /// consecutive points of one run, on one surface when the gap test above holds
@@ -178,6 +185,7 @@ impl Default for IcpParams {
             max_line_fit_rms: 0.01,
             discontinuity_min_gap: 0.05,
             discontinuity_gap_factor: 10.0,
+            mixed_pixel_sigmas: 3.0,
             bridged_missing_rays: 2,
             min_valid_points: 20,
             min_correspondences: 20,
@@ -238,6 +246,9 @@ impl IcpParams {
         }
         if !positive(self.discontinuity_min_gap) || !positive(self.discontinuity_gap_factor) {
             return bad("discontinuity_min_gap and discontinuity_gap_factor must be positive");
+        }
+        if self.mixed_pixel_sigmas.is_nan() || self.mixed_pixel_sigmas <= 0.0 {
+            return bad("mixed_pixel_sigmas must be positive (infinity keeps every reading)");
         }
         if self.min_valid_points < 3 || self.min_correspondences < 3 {
             return bad("min_valid_points and min_correspondences must be at least 3");

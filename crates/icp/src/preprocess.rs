@@ -11,6 +11,7 @@
 //! On noise-free straight walls the local line is the wall itself.
 
 use crate::consistency::EXACT_NOISE_SHARE;
+use crate::mixed_pixels::mixed_pixel_readings;
 use crate::neighbourhood_lines::{NeighbourhoodLines, MAX_POINTS, NOISE_RADIUS};
 use crate::{IcpError, IcpParams, NeighbourSearch};
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
@@ -139,7 +140,52 @@ impl PreparedScan {
     /// `params.min_reading`, and below both `max_range` and `params.max_reading`.
     /// Errors: arrays of different lengths, non-finite angles, invalid parameters, or
     /// fewer than `params.min_valid_points` valid readings.
+    ///
+    /// Mixed pixels (readings at depth edges on neither surface; see
+    /// [`IcpParams::mixed_pixel_sigmas`]) are left out as readings without a return.
+    /// They are judged against `params.typical_noise_sigma` when it is given (the
+    /// pipeline gives the log's), else against the range noise the scan shows about
+    /// its local lines, which takes a first preparation.
     pub fn new(
+        ranges: &[f32],
+        angles: &[f64],
+        min_range: f64,
+        max_range: f64,
+        params: &IcpParams,
+    ) -> Result<PreparedScan, IcpError> {
+        // The log's typical noise when the caller knows it (one preparation, and the
+        // same judgement whichever way the rays are listed); else the scan's own,
+        // which takes a first preparation.
+        let typical = Some(params.typical_noise_sigma).filter(|&s| s > 0.0);
+        let (first, sigma) = match typical {
+            Some(_) => (None, typical),
+            None => {
+                let scan = Self::prepare(ranges, angles, min_range, max_range, params)?;
+                let sigma = scan.noise_sigma;
+                (Some(scan), sigma)
+            }
+        };
+        let (lo, hi) = (
+            min_range.max(params.min_reading),
+            max_range.min(params.max_reading),
+        );
+        let mixed = mixed_pixel_readings(ranges, angles, lo, hi, sigma, params);
+        if !mixed.contains(&true) {
+            return match first {
+                Some(scan) => Ok(scan),
+                None => Self::prepare(ranges, angles, min_range, max_range, params),
+            };
+        }
+        let cleaned: Vec<f32> = ranges
+            .iter()
+            .zip(&mixed)
+            .map(|(&r, &m)| if m { 0.0 } else { r })
+            .collect();
+        Self::prepare(&cleaned, angles, min_range, max_range, params)
+    }
+
+    /// [`PreparedScan::new`] without judging mixed pixels: every valid reading kept.
+    fn prepare(
         ranges: &[f32],
         angles: &[f64],
         min_range: f64,
@@ -314,7 +360,8 @@ impl PreparedScan {
         polar.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
         let angles: Vec<f64> = polar.iter().map(|p| p.0).collect();
         let ranges: Vec<f32> = polar.iter().map(|p| p.1).collect();
-        let mut cloud = PreparedScan::new(&ranges, &angles, 0.0, f64::INFINITY, params)?;
+        // A cloud's neighbouring entries are not neighbouring rays: no mixed pixels.
+        let mut cloud = PreparedScan::prepare(&ranges, &angles, 0.0, f64::INFINITY, params)?;
         cloud.cloud = true;
         cloud.placed = polar.iter().map(|p| p.2).collect();
         Ok(cloud)
@@ -914,5 +961,51 @@ mod tests {
         assert!(scan.segments[18].is_some() && scan.segments[20].is_some());
         let far = scan.segments[25].expect("far wall");
         assert!((far.offset + 2.0).abs() < 1e-6, "{far:?}");
+    }
+
+    #[test]
+    fn mixed_pixels_are_left_out_as_readings_without_a_return() {
+        // Two walls 1 m and 2 m ahead, rays 0.3° apart, ray 19 a mixed pixel: 4 cm
+        // behind the near wall's end, towards the far one.
+        let angles: Vec<f64> = (0..40).map(|i| -0.1 + 0.005 * i as f64).collect();
+        let mut ranges: Vec<f32> = angles
+            .iter()
+            .enumerate()
+            .map(|(i, a)| ((if i < 20 { 1.0 } else { 2.0 }) / a.cos()) as f32)
+            .collect();
+        ranges[19] = (1.04 / angles[19].cos()) as f32;
+        let scan = PreparedScan::new(&ranges, &angles, 0.02, 4.0, &IcpParams::default())
+            .expect("enough valid points");
+        assert_eq!(scan.points.len(), 39);
+        assert!(!scan.original.contains(&19));
+        // The near wall's run ends at ray 18 and is not joined to the far wall.
+        let k = scan.original.iter().position(|&i| i == 18).expect("ray 18");
+        assert!(scan.segments[k].is_none() && scan.segments[k - 1].is_some());
+        // Judged with the log's typical noise instead of the scan's own: the same.
+        let typical = IcpParams {
+            typical_noise_sigma: 0.005,
+            ..IcpParams::default()
+        };
+        let scan = PreparedScan::new(&ranges, &angles, 0.02, 4.0, &typical).expect("points");
+        assert!(!scan.original.contains(&19));
+        // Rays 1.4° apart are not judged (mixed_pixels::MAX_RAY_STEP).
+        let coarse: Vec<f64> = (0..40).map(|i| -0.5 + 0.025 * i as f64).collect();
+        let scan = PreparedScan::new(&ranges, &coarse, 0.02, 4.0, &typical).expect("points");
+        assert_eq!(scan.points.len(), 40);
+        // Kept when the judgement is switched off; a cloud (entries that are not
+        // neighbouring rays) keeps every point.
+        let kept = IcpParams {
+            mixed_pixel_sigmas: f64::INFINITY,
+            ..IcpParams::default()
+        };
+        let scan = PreparedScan::new(&ranges, &angles, 0.02, 4.0, &kept).expect("valid points");
+        assert_eq!(scan.points.len(), 40);
+        let points: Vec<[f64; 2]> = ranges
+            .iter()
+            .zip(&angles)
+            .map(|(&r, a)| [f64::from(r) * a.cos(), f64::from(r) * a.sin()])
+            .collect();
+        let cloud = PreparedScan::from_points(&points, &[], &IcpParams::default()).unwrap();
+        assert_eq!(cloud.points.len(), 40);
     }
 }
