@@ -15,7 +15,7 @@
 //! few centimetres off a surface: close enough to be joined to its run, so that
 //! lines are fitted through them and they pass the trimming. So a reading is judged
 //! where a run ends at a depth edge: the run's last readings before it (up to
-//! [`SIDE_POINTS`] on the run) give a line, continued to its ray. The reading is a
+//! [`RUN_POINTS`] on the run) give a line, continued to its ray. The reading is a
 //! mixed pixel when it lies off that continuation towards the surface across the
 //! edge by more than [`crate::IcpParams::mixed_pixel_sigmas`] times the noise of that
 //! prediction, the range noise being the scans' (see [`mixed_pixel_readings`]) or
@@ -32,7 +32,7 @@ use crate::params::IcpParams;
 
 /// The most readings of a run that its continuation is fitted to; their scatter
 /// about it is the run's own noise.
-const SIDE_POINTS: usize = 5;
+const RUN_POINTS: usize = 5;
 
 /// Scans whose rays are farther apart on average (rad; 0.6°) are not judged: the
 /// URG-04LX (0.35°) and the RPLIDAR (0.5°) are, 1° lasers are not. On those, a run's
@@ -42,8 +42,8 @@ const SIDE_POINTS: usize = 5;
 /// widened its σ by 2 %.
 const MAX_RAY_STEP: f64 = 0.6 * std::f64::consts::PI / 180.0;
 
-/// Rays seen at a larger incidence on a side's line (|cos| below this) do not let
-/// that side judge: its continuation's range is too uncertain there.
+/// A reading whose ray meets its run's line at a larger incidence (|cos| below this)
+/// is not judged: the continuation's range is too uncertain there.
 const MIN_JUDGING_COS: f64 = 0.2;
 
 /// The least range noise (m) a reading is judged with: quantisation (1 mm on most
@@ -123,24 +123,24 @@ pub(crate) fn mixed_pixel_readings(
             [r * cos, r * sin]
         };
         let p = point(i, r);
-        // The own side's readings: i ± 1, i ± 2, … while on one surface.
-        let mut side = Vec::with_capacity(SIDE_POINTS);
+        // Its run's readings before it: i ± 1, i ± 2, … while on one surface.
+        let mut run = Vec::with_capacity(RUN_POINTS);
         let mut k = i as isize + own;
-        while side.len() < SIDE_POINTS && (0..n as isize).contains(&k) {
+        while run.len() < RUN_POINTS && (0..n as isize).contains(&k) {
             let ku = k as usize;
             let Some(rk) = range(ku) else { break };
-            if !side.is_empty() && !joined[ku.min((ku as isize - own) as usize)] {
+            if !run.is_empty() && !joined[ku.min((ku as isize - own) as usize)] {
                 break;
             }
-            side.push(point(ku, rk));
+            run.push(point(ku, rk));
             k += own;
         }
-        // Off its own surface's continuation, towards the surface across the edge.
-        if let Some((along, spread, local)) = continuation_residual(&side, p) {
-            let towards = along * (r_across - r).signum();
-            // The noise its own run shows, where that is larger than the log's
-            // (a far wall's, when the range noise grows with range).
-            if towards > params.mixed_pixel_sigmas * sigma.max(local) * spread {
+        // Off its run's continuation, towards the surface across the edge, by more
+        // than the noise: the log's, or the run's own where that is larger (a far
+        // wall's, when the range noise grows with range).
+        if let Some(c) = Continuation::of(&run, p) {
+            let towards = c.along * (r_across - r).signum();
+            if towards > params.mixed_pixel_sigmas * sigma.max(c.scatter) * c.spread {
                 mixed[i] = true;
             }
         }
@@ -148,60 +148,76 @@ pub(crate) fn mixed_pixel_readings(
     mixed
 }
 
-/// How far `p` lies off the line through `points` (at least two), along `p`'s own
-/// ray (m); the standard deviation of that distance per unit range noise under the
-/// hypothesis that `p` is on the line; and the range noise the points show about
-/// their line (m, along `p`'s ray; 0 with fewer than four points). `None` when the
-/// points are fewer than two or the ray meets the line at grazing incidence.
-fn continuation_residual(points: &[[f64; 2]], p: [f64; 2]) -> Option<(f64, f64, f64)> {
-    let m = points.len();
-    if m < 2 {
-        return None;
+/// A reading against the line through its run's readings before it.
+struct Continuation {
+    /// How far the reading lies off the line, along its own ray (m; positive beyond
+    /// the line).
+    along: f64,
+    /// The standard deviation of `along` per unit range noise were the reading on
+    /// the line: its own noise and the line's at that distance from the run.
+    spread: f64,
+    /// The range noise the run's readings show about their line (m, along the
+    /// reading's ray; 0 from fewer than four readings).
+    scatter: f64,
+}
+
+impl Continuation {
+    /// The reading `p` against the line through `points`; `None` with fewer than two
+    /// points, or when `p`'s ray meets the line at grazing incidence.
+    fn of(points: &[[f64; 2]], p: [f64; 2]) -> Option<Continuation> {
+        let m = points.len();
+        if m < 2 {
+            return None;
+        }
+        let mf = m as f64;
+        let c = points
+            .iter()
+            .fold([0.0, 0.0], |a, q| [a[0] + q[0] / mf, a[1] + q[1] / mf]);
+        let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+        for q in points {
+            let (dx, dy) = (q[0] - c[0], q[1] - c[1]);
+            sxx += dx * dx;
+            sxy += dx * dy;
+            syy += dy * dy;
+        }
+        // The line's direction: the scatter's principal axis.
+        let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+        let tangent = [angle.cos(), angle.sin()];
+        let normal = [-tangent[1], tangent[0]];
+        let s_tt = sxx * tangent[0] * tangent[0]
+            + 2.0 * sxy * tangent[0] * tangent[1]
+            + syy * tangent[1] * tangent[1];
+        if s_tt.is_nan() || s_tt <= 0.0 {
+            return None;
+        }
+        let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
+        let dir = [p[0] / r, p[1] / r];
+        let cos = normal[0] * dir[0] + normal[1] * dir[1];
+        if cos.abs() < MIN_JUDGING_COS {
+            return None;
+        }
+        // Distance of p from the line, then along its ray.
+        let off = normal[0] * (p[0] - c[0]) + normal[1] * (p[1] - c[1]);
+        let t = tangent[0] * (p[0] - c[0]) + tangent[1] * (p[1] - c[1]);
+        // Perpendicular noise of each reading ≈ σ·|cos|; the line's error at `t`
+        // (1/m + t²/S_tt) and p's own add up; along the ray, divided by |cos| again.
+        let spread = (1.0 + 1.0 / mf + t * t / s_tt).sqrt();
+        // The points' own scatter about the line (m − 2 degrees of freedom), along the
+        // ray; from four points on.
+        let s_nn = sxx * normal[0] * normal[0]
+            + 2.0 * sxy * normal[0] * normal[1]
+            + syy * normal[1] * normal[1];
+        let scatter = if m >= 4 {
+            (s_nn / (mf - 2.0)).sqrt() / cos.abs()
+        } else {
+            0.0
+        };
+        Some(Continuation {
+            along: off / cos,
+            spread,
+            scatter,
+        })
     }
-    let mf = m as f64;
-    let c = points
-        .iter()
-        .fold([0.0, 0.0], |a, q| [a[0] + q[0] / mf, a[1] + q[1] / mf]);
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for q in points {
-        let (dx, dy) = (q[0] - c[0], q[1] - c[1]);
-        sxx += dx * dx;
-        sxy += dx * dy;
-        syy += dy * dy;
-    }
-    // The line's direction: the scatter's principal axis.
-    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
-    let tangent = [angle.cos(), angle.sin()];
-    let normal = [-tangent[1], tangent[0]];
-    let s_tt = sxx * tangent[0] * tangent[0]
-        + 2.0 * sxy * tangent[0] * tangent[1]
-        + syy * tangent[1] * tangent[1];
-    if s_tt.is_nan() || s_tt <= 0.0 {
-        return None;
-    }
-    let r = (p[0] * p[0] + p[1] * p[1]).sqrt();
-    let dir = [p[0] / r, p[1] / r];
-    let cos = normal[0] * dir[0] + normal[1] * dir[1];
-    if cos.abs() < MIN_JUDGING_COS {
-        return None;
-    }
-    // Distance of p from the line, then along its ray.
-    let off = normal[0] * (p[0] - c[0]) + normal[1] * (p[1] - c[1]);
-    let t = tangent[0] * (p[0] - c[0]) + tangent[1] * (p[1] - c[1]);
-    // Perpendicular noise of each reading ≈ σ·|cos|; the line's error at `t`
-    // (1/m + t²/S_tt) and p's own add up; along the ray, divided by |cos| again.
-    let spread = (1.0 + 1.0 / mf + t * t / s_tt).sqrt();
-    // The points' own scatter about the line (m − 2 degrees of freedom), along the
-    // ray; from four points on.
-    let s_nn = sxx * normal[0] * normal[0]
-        + 2.0 * sxy * normal[0] * normal[1]
-        + syy * normal[1] * normal[1];
-    let local = if m >= 4 {
-        (s_nn / (mf - 2.0)).sqrt() / cos.abs()
-    } else {
-        0.0
-    };
-    Some((off / cos, spread, local))
 }
 
 #[cfg(test)]

@@ -81,10 +81,11 @@ pub struct IcpParams {
     pub discontinuity_gap_factor: f64,
     /// The last reading of a run at a depth edge that lies off the run's
     /// continuation, towards the surface across the edge, by more than this many
-    /// standard deviations (the range noise, with the continuation's own
-    /// uncertainty) is a mixed pixel, left out of the scan as a reading without a
-    /// return; only in scans of rays at most 0.6° apart (see the crate
-    /// documentation, step 1). 3 by default; infinity keeps every reading.
+    /// standard deviations (of the range noise — the log's typical one, or the
+    /// run's own scatter where larger — with the continuation's own uncertainty) is
+    /// a mixed pixel, left out of the scan as a reading without a return; only in
+    /// scans of rays at most 0.6° apart (see the crate documentation, step 1). 3 by
+    /// default; infinity keeps every reading.
     pub mixed_pixel_sigmas: f64,
     /// Two valid points with up to this many readings without a return between them
     /// (zero, NaN or at most the minimum range: dropouts, dark or glancing spots) are
