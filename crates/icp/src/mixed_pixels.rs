@@ -97,11 +97,7 @@ pub(crate) fn mixed_pixel_readings(
     let joined: Vec<bool> = (0..n.saturating_sub(1))
         .map(|i| match (range(i), range(i + 1)) {
             (Some(a), Some(b)) => {
-                let step = (angles[i + 1] - angles[i]).abs();
-                let gap = params
-                    .discontinuity_min_gap
-                    .max(params.discontinuity_gap_factor * a.max(b) * step);
-                (a - b).abs() <= gap
+                (a - b).abs() <= params.run_gap(a.max(b), angles[i + 1] - angles[i])
             }
             _ => false,
         })

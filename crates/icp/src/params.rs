@@ -207,6 +207,23 @@ impl Default for IcpParams {
 }
 
 impl IcpParams {
+    /// The largest gap (m) between two consecutive points of one run: `range` the
+    /// larger of their ranges (m), `step` the angle between their rays (rad); see
+    /// [`IcpParams::discontinuity_min_gap`].
+    pub(crate) fn run_gap(&self, range: f64, step: f64) -> f64 {
+        self.discontinuity_min_gap
+            .max(self.discontinuity_gap_factor * range * step.abs())
+    }
+
+    /// The readings a scan keeps are those strictly between these (m): its own
+    /// `min_range` and `max_range`, narrowed by `min_reading` and `max_reading`.
+    pub(crate) fn reading_bounds(&self, min_range: f64, max_range: f64) -> (f64, f64) {
+        (
+            min_range.max(self.min_reading),
+            max_range.min(self.max_reading),
+        )
+    }
+
     /// Checks that every parameter is in its meaningful range.
     pub fn validate(&self) -> Result<(), crate::IcpError> {
         let bad = |what: &str| Err(crate::IcpError::InvalidParams(what.to_string()));

@@ -165,10 +165,7 @@ impl PreparedScan {
                 (Some(scan), sigma)
             }
         };
-        let (lo, hi) = (
-            min_range.max(params.min_reading),
-            max_range.min(params.max_reading),
-        );
+        let (lo, hi) = params.reading_bounds(min_range, max_range);
         let mixed = mixed_pixel_readings(ranges, angles, lo, hi, sigma, params);
         if !mixed.contains(&true) {
             return match first {
@@ -212,8 +209,7 @@ impl PreparedScan {
             ));
         }
         let ray_count = ranges.len();
-        let lo = min_range.max(params.min_reading);
-        let hi = max_range.min(params.max_reading);
+        let (lo, hi) = params.reading_bounds(min_range, max_range);
         let ray_step = mean_step(angles);
         let no_return = no_returns(ranges, lo);
         let (original, bridgeable) = kept_readings(ranges, lo, hi, params.bridged_missing_rays);
@@ -580,9 +576,7 @@ fn connections(
             continue;
         }
         let r = f64::from(ranges[i].max(ranges[i + 1]));
-        let gap_allowed = params
-            .discontinuity_min_gap
-            .max(params.discontinuity_gap_factor * r * (angles[i + 1] - angles[i]).abs());
+        let gap_allowed = params.run_gap(r, angles[i + 1] - angles[i]);
         let (p, q) = (points[i], points[i + 1]);
         let (dx, dy) = (q[0] - p[0], q[1] - p[1]);
         connected[i] = dx * dx + dy * dy <= gap_allowed * gap_allowed;
