@@ -170,10 +170,18 @@ fn clean_logs_do_not_raise_the_slide() {
         let slip = report.lateral_slip.expect("the slide is checked");
         println!("{preset} seed {seed}: {slip:?}");
         assert!(!slide_found(&report), "{preset}: {slip:?}");
-        // Off gives the same numbers: the six-parameter estimate is untouched.
+        // The slide weighs little (an outward k well below 2σ), or nothing (inward):
+        // the estimate is Off's, the six-parameter one, within a tenth of its σ.
+        assert!(slip.weight < 0.2, "{preset}: {slip:?}");
         let off = calibrate(&path, &with_model(SlideModel::Off));
-        assert_eq!(off.values(), report.values(), "{preset}");
         assert!(off.lateral_slip.is_none());
+        if slip.weight == 0.0 {
+            assert_eq!(off.values(), report.values(), "{preset}");
+        }
+        for i in 0..6 {
+            let moved = (report.values()[i] - off.values()[i]).abs() / off.sigma[i];
+            assert!(moved < 0.1, "{preset}: parameter {i} moved {moved:.3}σ");
+        }
         cleanup(&path);
     }
 }

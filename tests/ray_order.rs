@@ -101,13 +101,6 @@ fn a_swept_log_calibrates_the_same_with_its_rays_listed_the_other_way() {
     same_both_orders("mines-rover", &simulated_120s("mines-rover", 8), 0.25, 0);
 }
 
-/// The two values the real exp2 log's ℓx takes (m): the ranges changed by ±1 mm in a
-/// fifth of the readings send it to one or the other, whichever way its rays are
-/// listed (118–132 mm with σ 11–17 mm, or 160–177 mm with σ 21–23 mm, in 14 draws
-/// with and without mixed pixels left out; docs/benchmarks.md, stop 42): which
-/// samples the solve keeps decides it, not the order of the rays.
-const EXP2_L_X_MODES: [std::ops::Range<f64>; 2] = [0.110..0.140, 0.150..0.185];
-
 #[test]
 fn the_real_logs_calibrate_the_same_with_their_rays_listed_the_other_way() {
     for name in ["exp1.log", "exp2.log"] {
@@ -115,33 +108,27 @@ fn the_real_logs_calibrate_the_same_with_their_rays_listed_the_other_way() {
             continue;
         };
         let log = odocal_log::read_log(&path, &Default::default()).unwrap();
-        // Measured (stop 42, mixed pixels left out): exp1 160 and 157 samples, b
-        // −0.54σ, ℓy +0.24σ; exp2 120 and 122, r_L −1.54σ, r_R −1.32σ, ℓy −0.79σ, ℓx
-        // 167 and 168 mm. Before: exp1 163 and 160, b −0.32σ, ℓθ −0.33σ; exp2 121
-        // and 122, ℓy −0.38σ, ℓx −0.31σ. The chaos floor is higher than the module
-        // documentation's 0.33σ (two units in the last place): with ranges changed
-        // by ±1 mm, the URG's quantum, in a fifth of the readings (seven draws, the
-        // log itself among them, on main; stop 42), two draws differed by up to
-        // 0.98σ for exp1 and 1.41σ for exp2 (ℓx aside). The bounds are those, with
-        // a margin for what seven draws do not show: 1.2σ and 1.7σ.
+        // Measured (stop 43, the slide weighed in): exp1 160 and 158 samples, ℓθ
+        // +0.68σ, ℓx +0.46σ; exp2 120 and 122, r_L −1.43σ, r_R −1.20σ, ℓy −0.96σ, ℓx
+        // −0.05σ. The chaos floor is higher than the module documentation's 0.33σ
+        // (two units in the last place): with ranges changed by ±1 mm, the URG's
+        // quantum, in a fifth of the readings (seven draws, the log itself among
+        // them), two draws differ by up to 1.13σ for exp1 (ℓx) and 1.55σ for exp2
+        // (r_L). Until stop 43 exp2's ℓx took one of two values 40 mm apart under
+        // such changes (the slide switched on at 2σ, its k at 2.1σ): weighed in by
+        // its evidence, it moves by 0.91σ at most, and is bounded with the rest.
+        // The bounds are the chaos with a margin for what seven draws do not show.
         let bound = if name == "exp2.log" { 1.7 } else { 1.2 };
         let b = both_orders(name, &log);
         let (n, m) = b.samples;
         assert!(n.abs_diff(m) <= 5, "{name}: {n} and {m} samples");
         for i in 0..6 {
-            if name == "exp2.log" && i == 3 {
-                for v in [b.listed[i], b.reversed[i]] {
-                    assert!(
-                        EXP2_L_X_MODES.iter().any(|r| r.contains(&v)),
-                        "{name}: l_x {v} in neither of its two values"
-                    );
-                }
-                continue;
-            }
             assert!(
                 b.moved[i].abs() <= bound,
-                "{name}: parameter {i} moved {:.3} σ",
-                b.moved[i]
+                "{name}: parameter {i} moved {:.3} σ (listed {}, reversed {})",
+                b.moved[i],
+                b.listed[i],
+                b.reversed[i]
             );
         }
     }

@@ -4,13 +4,13 @@
 //!
 //! The check is the seven-parameter fit itself: `k` with its σ, from the lateral
 //! residuals' dependence on the slide's predicted displacement (the same turn driven
-//! faster slides more), the six parameters re-fitted with it. It fires when `k` is
-//! outward (`k > 0`, what a skid-steer robot's wheels do), likely (above
-//! [`PRECAUTION`] σ; above [`SIGNIFICANCE`] σ the finding says the robot slides) and matters (it moves some parameter — ℓx in most logs, ℓθ
-//! where the arcs are what fix the heading — by more than its own σ); then the
-//! estimate includes it and a finding says so. An outward `k` too uncertain to be
-//! sure of that would still move a parameter by more than its σ gets a note naming
-//! `--lateral-slip`; an inward `k` as significant is no slide a robot does: named,
+//! faster slides more), the six parameters re-fitted with it. The estimate weighs the
+//! two models by the evidence for an outward slide ([`slide_weight`]: `k > 0`, what a
+//! skid-steer robot's wheels do; even odds at [`PRECAUTION`] σ, all but certain from
+//! [`SIGNIFICANCE`] σ), and its covariance holds both models and the difference
+//! between them, so that neither moves by a jump when `k` crosses a threshold. A
+//! finding says so when the slide carries weight or would move a parameter by more
+//! than its σ in full; an inward `k` as significant is no slide a robot does: named,
 //! not used.
 
 use crate::finding::{Finding, FindingKind};
@@ -20,13 +20,44 @@ use serde::Serialize;
 /// `|k| / σ` above which the slide counts as found: the robot slides.
 pub const SIGNIFICANCE: f64 = 4.0;
 
-/// `|k| / σ` above which an outward slide that matters is estimated all the same, as
-/// a precaution: estimating a slide that is not there costs only σ (the estimate of
-/// the six stays unbiased), ignoring one that is there biases them. On the simulated
+/// `|k| / σ` at which an outward slide weighs as much as no slide in the estimate
+/// ([`slide_weight`]), as a precaution: estimating a slide that is not there costs
+/// only σ (the estimate of the six stays unbiased), ignoring one that is there
+/// biases them. (Before the weighing, the slide was estimated in full from here.) On the simulated
 /// MinesRover (truth k = 0.05 s, 12 seeds × 120 s) estimating from 2σ instead of 4σ
 /// took the RMS error/σ of ℓx from 1.26 to 1.04 and of ℓθ from 1.91 to 1.44; no
 /// TurtleBot 4 log (no slide, 12 seeds, |k|/σ at most 0.9) estimated it.
 pub const PRECAUTION: f64 = 2.0;
+
+/// The share of the model with the slide in the estimate of [`SlideModel::Auto`]:
+/// 0 for an inward or zero `k`, rising smoothly with the evidence for an outward
+/// one. It is the probability of the model with the slide against the one without
+/// when the slide's likelihood gain, `z²/2` for `z = k/σ`, is weighed against a
+/// penalty of `PRECAUTION²/2` (even odds at `z` = [`PRECAUTION`]), rescaled so that
+/// `k = 0` weighs nothing: 0.06 at 0.9σ, 0.43 at 2σ, 0.91 at 3σ, 0.999 at 4σ.
+///
+/// A switch at `PRECAUTION` instead made the estimate jump with the samples: the
+/// real MinesRover exp2 has `k` at 2.1σ, and redrawing a fifth of its ranges by
+/// ±1 mm put it on either side of 2σ, so that ℓx took one of two values 40 mm apart
+/// (`docs/benchmarks.md`, stop 42) while each value's σ claimed 11–26 mm. Weighed,
+/// the estimate and its covariance move continuously with `k`, and near the
+/// threshold the σ hold the difference between the two models.
+pub fn slide_weight(slip: &LateralSlip) -> f64 {
+    // An inward k, zero or NaN: no slide a robot does.
+    if slip.k.is_nan() || slip.k <= 0.0 {
+        return 0.0;
+    }
+    let z = slip.significance();
+    if !z.is_finite() {
+        return 1.0;
+    }
+    let probability = |z2: f64| 1.0 / (1.0 + (-(z2 - PRECAUTION * PRECAUTION) / 2.0).exp());
+    let at_zero = probability(0.0);
+    ((probability(z * z) - at_zero) / (1.0 - at_zero)).clamp(0.0, 1.0)
+}
+
+/// A weight from which the slide counts as estimated in full in the words (4σ).
+const FULL_WEIGHT: f64 = 0.995;
 
 /// Which odometry model the solve uses.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
@@ -48,12 +79,6 @@ fn matters(slip: &LateralSlip, covariance: &[[f64; 6]; 6]) -> Option<(usize, f64
     slip.largest_shift(covariance).filter(|(_, n)| *n > 1.0)
 }
 
-/// Whether a checked slide is one to estimate: outward, above [`PRECAUTION`] σ, and
-/// moving some parameter by more than its σ without it.
-fn found(slip: &LateralSlip, covariance: &[[f64; 6]; 6]) -> bool {
-    slip.k > 0.0 && slip.significance() > PRECAUTION && matters(slip, covariance).is_some()
-}
-
 /// "ℓθ by −0.0050 rad (−0.29°), 2.2 times its σ": what ignoring the slide does to
 /// parameter `i`, moved `n` σ.
 fn shift_words(slip: &LateralSlip, i: usize, n: f64) -> String {
@@ -73,8 +98,8 @@ fn shift_words(slip: &LateralSlip, i: usize, n: f64) -> String {
 }
 
 /// Checks `calibration` (computed from `samples` with `options`) for the slide and,
-/// as `model` says, replaces its estimate by the one with the slide. The slide is
-/// recorded in `calibration.lateral_slip` whenever it was checked.
+/// as `model` says, weighs the estimate with the slide into it ([`slide_weight`]).
+/// The slide is recorded in `calibration.lateral_slip` whenever it was checked.
 pub fn check_and_apply(
     calibration: &mut Calibration,
     samples: &[Sample],
@@ -87,11 +112,11 @@ pub fn check_and_apply(
     let Some(fit) = fit_lateral_slip(samples, calibration, options) else {
         return;
     };
-    if model == SlideModel::Estimate || found(&fit.slip, &calibration.covariance) {
-        fit.apply(calibration);
-    } else {
-        calibration.lateral_slip = Some(fit.slip);
-    }
+    let weight = match model {
+        SlideModel::Estimate => 1.0,
+        _ => slide_weight(&fit.slip),
+    };
+    fit.blend(calibration, weight);
 }
 
 /// The finding for the slide of a calibration, when it was estimated, is
@@ -120,24 +145,17 @@ pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> 
         1e3 * slip.k * slip.turning_speed * slip.turn_rate,
     );
     let shift = format!("ignoring it moves ℓx by {:+.1} mm", -1e3 * slip.l_x_shift);
-    if slip.applied {
+    let what = if slip.k > 0.0 && slip.significance() > SIGNIFICANCE {
+        "the robot slides sideways in turns"
+    } else if slip.k > 0.0 && slip.significance() > PRECAUTION {
+        "the robot likely slides sideways in turns"
+    } else {
+        "sideways slide in turns"
+    };
+    if slip.applied && slip.weight >= FULL_WEIGHT {
         let why = match model {
             SlideModel::Estimate => "estimated as asked (`--lateral-slip`)",
-            _ if slip.significance() > SIGNIFICANCE => {
-                "estimated as a seventh parameter (`--no-lateral-slip` leaves it out)"
-            }
-            _ => {
-                "estimated as a seventh parameter as a precaution, since ignoring a slide \
-                 that is there would bias the parameters while estimating one that is not \
-                 only widens σ (`--no-lateral-slip` leaves it out)"
-            }
-        };
-        let what = if slip.k > 0.0 && slip.significance() > SIGNIFICANCE {
-            "the robot slides sideways in turns"
-        } else if slip.k > 0.0 && slip.significance() > PRECAUTION {
-            "the robot likely slides sideways in turns"
-        } else {
-            "sideways slide in turns"
+            _ => "estimated as a seventh parameter (`--no-lateral-slip` leaves it out)",
         };
         return Some(Finding::warning(
             FindingKind::LateralSlip,
@@ -147,25 +165,32 @@ pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> 
             ),
         ));
     }
-    let moved = matters(slip, &calibration.covariance);
-    if let (true, Some((i, n))) = (slip.k > 0.0, moved) {
-        // Too uncertain to estimate, but it would matter: a skid-steer robot's user
-        // should know what the slide would do to the parameters.
-        let also = if i == 3 {
-            String::new()
-        } else {
-            format!(" (ℓx by {:+.1} mm)", -1e3 * slip.l_x_shift)
+    if slip.applied {
+        // Weighed: said when it carries weight or would matter in full.
+        let moved = matters(slip, &calibration.covariance);
+        if slip.weight < 0.5 && moved.is_none() {
+            return None;
+        }
+        let also = match moved {
+            Some((i, n)) if i != 3 => format!(" and {}", shift_words(slip, i, n)),
+            _ => String::new(),
         };
-        return Some(Finding::note(
-            FindingKind::LateralSlip,
-            format!(
-                "a sideways slide in turns is not excluded: {numbers}, {:.1}σ, too little \
-                 to be sure; if the robot slides (a skid-steer robot does), ignoring it moves \
-                 {}{also}: `--lateral-slip` estimates the slide with the six parameters",
-                slip.significance(),
-                shift_words(slip, i, n)
-            ),
-        ));
+        let message = format!(
+            "{what}: {numbers}; {shift}{also}; the estimate weighs the model with the \
+             slide at {:.0} % and the one without at {:.0} %, by the evidence for it (k at \
+             {:.1}σ of the residuals' noise; even odds at {PRECAUTION}σ, all but certain from \
+             {SIGNIFICANCE}σ), and the σ of every parameter include both models and the \
+             difference between them (`--lateral-slip` estimates the slide in full, as a \
+             skid-steer robot needs; `--no-lateral-slip` leaves it out)",
+            100.0 * slip.weight,
+            100.0 * (1.0 - slip.weight),
+            slip.evidence,
+        );
+        return Some(if slip.weight >= 0.5 {
+            Finding::warning(FindingKind::LateralSlip, message)
+        } else {
+            Finding::note(FindingKind::LateralSlip, message)
+        });
     }
     (slip.significance() > SIGNIFICANCE && slip.k < 0.0).then(|| {
         Finding::warning(
@@ -194,20 +219,26 @@ mod tests {
             turning_speed: 0.3,
             turn_rate: 0.5,
             applied: false,
+            weight: 0.0,
+            evidence: k / sigma,
+        }
+    }
+
+    /// A robot whose laser is turned by `laser_theta` (rad).
+    fn robot(laser_theta: f64) -> odocal_solver::Params {
+        odocal_solver::Params {
+            r_l: 0.03,
+            r_r: 0.031,
+            b: 0.3,
+            laser: odocal_geom::Pose2::new(0.1, 0.02, laser_theta),
         }
     }
 
     #[test]
     fn a_slide_asked_for_that_the_data_cannot_give_is_said() {
         use odocal_geom::Pose2;
-        use odocal_solver::{calibrate, Params, Predictor};
-        let truth = Params {
-            r_l: 0.03,
-            r_r: 0.031,
-            b: 0.3,
-            laser: Pose2::new(0.1, 0.02, 1.0),
-        };
-        let predictor = Predictor::new(&truth, true);
+        use odocal_solver::{calibrate, Predictor};
+        let predictor = Predictor::new(&robot(1.0), true);
         let samples: Vec<Sample> = (0..60)
             .map(|k| {
                 let (l, r) = [(5.0, 5.0), (-4.0, 4.0), (2.0, 6.0)][k % 3];
@@ -231,28 +262,70 @@ mod tests {
     }
 
     #[test]
-    fn only_an_outward_significant_slide_that_moves_a_parameter_is_found() {
-        // σ: 1 mm for the distances, 2 mrad for ℓθ.
-        let mut cov = [[0.0; 6]; 6];
-        for (i, row) in cov.iter_mut().enumerate() {
-            row[i] = if i == 5 { 4e-6 } else { 1e-6 };
+    fn the_slide_weighs_as_its_evidence_and_nothing_inward() {
+        // k / σ = 0, 0.9, 2, 3, 4; inward.
+        let w = |k: f64| slide_weight(&slip(k, 0.01, 0.005));
+        assert_eq!(w(0.0), 0.0);
+        assert_eq!(w(-0.05), 0.0);
+        assert!((w(0.009) - 0.057).abs() < 0.005, "{}", w(0.009));
+        assert!((w(0.02) - 0.433).abs() < 0.005, "{}", w(0.02));
+        assert!((w(0.03) - 0.914).abs() < 0.005, "{}", w(0.03));
+        assert!(w(0.04) > 0.995 && w(0.04) < 1.0, "{}", w(0.04));
+        // Rising, without a jump: no step of 0.1σ changes the weight by more than 0.06.
+        let mut last = 0.0;
+        for i in 1..=100 {
+            let now = w(0.0005 * i as f64);
+            assert!(now >= last && now - last < 0.06, "{i}: {last} -> {now}");
+            last = now;
         }
-        assert!(found(&slip(0.05, 0.01, 0.005), &cov));
-        // Inward: no wheel slides that way.
-        assert!(!found(&slip(-0.05, 0.01, -0.005), &cov));
-        // Below 4σ but above 2σ: estimated as a precaution; below 2σ: not.
-        assert!(found(&slip(0.035, 0.01, 0.005), &cov));
-        assert!(!found(&slip(0.015, 0.01, 0.005), &cov));
-        // Significant but moving ℓx by less than its σ, and nothing else.
-        assert!(!found(&slip(0.05, 0.01, 0.0005), &cov));
-        // ℓx barely, ℓθ by 3σ: found (the rover's heading in its arcs).
-        let mut s = slip(0.05, 0.01, 0.0005);
-        s.shifts[5] = 0.006;
-        assert!(found(&s, &cov));
-        assert_eq!(matters(&s, &cov).map(|(i, _)| i), Some(5));
-        // A held parameter (zero variance) does not count.
-        let mut held = cov;
-        held[5][5] = 0.0;
-        assert!(!found(&s, &held));
+        // A σ of zero: certain.
+        assert_eq!(slide_weight(&slip(0.05, 0.0, 0.005)), 1.0);
+    }
+
+    #[test]
+    fn a_weighed_slide_moves_the_estimate_in_proportion_and_widens_sigma_by_the_gap() {
+        use odocal_geom::Pose2;
+        use odocal_solver::{calibrate, fit_lateral_slip, Predictor};
+        let predictor = Predictor::new(&robot(0.1), true);
+        // Turns while translating at two speeds, straights and spins, a little noise.
+        let samples: Vec<Sample> = (0..120)
+            .map(|k| {
+                let (l, r) = [(5.0, 5.0), (-4.0, 4.0), (2.0, 6.0), (4.0, 12.0)][k % 4];
+                let f = 1.0 + 0.01 * (k % 7) as f64;
+                let s = Sample::from_rotations(0.5, l * f, r * f, Pose2::IDENTITY);
+                let p = predictor.predict(&s);
+                let e = 1e-3 * (((k * 7919) % 13) as f64 - 6.0);
+                Sample {
+                    sm: Pose2::from_array([p[0] + e, p[1] - 0.7 * e, p[2] + 0.3 * e]),
+                    ..s
+                }
+            })
+            .collect();
+        let options = SolveOptions::default();
+        let six = calibrate(&samples, &options).unwrap();
+        let fit = fit_lateral_slip(&samples, &six, &options).expect("a fit");
+        let (d, c7) = (fit.slip.shifts, fit.covariance);
+        for w in [0.0, 0.3, 0.5, 1.0] {
+            let mut cal = six.clone();
+            fit.clone().blend(&mut cal, w);
+            let (got, base) = (cal.params.to_vector(), six.params.to_vector());
+            for i in 0..6 {
+                assert!((got[i] - (base[i] + w * d[i])).abs() < 1e-12, "w {w}, {i}");
+                let want =
+                    (1.0 - w) * six.covariance[i][i] + w * c7[i][i] + w * (1.0 - w) * d[i] * d[i];
+                assert!(
+                    (cal.covariance[i][i] - want).abs() <= 1e-12 * want.abs().max(1e-30),
+                    "w {w}, {i}"
+                );
+            }
+            let slip = cal.lateral_slip.expect("recorded");
+            assert_eq!(slip.applied, w > 0.0);
+            assert_eq!(slip.weight, w);
+        }
+        // In full, exactly the joint estimate.
+        let mut cal = six.clone();
+        fit.clone().apply(&mut cal);
+        assert_eq!(cal.params, fit.params);
+        assert_eq!(cal.covariance, fit.covariance);
     }
 }

@@ -42,7 +42,7 @@ pub(crate) const ROWS: [Row; 27] = [
     Row { key: "cost_after", label: "Cost after refinement", meaning: "the same sum after the non-linear refinement (it should not be larger)" },
     Row { key: "observability", label: "Observability", meaning: "how well the motion in the log determines each parameter" },
     Row { key: "shared_scan_noise", label: "Scan noise shared by consecutive samples", meaning: "consecutive samples share a scan, so their matching errors are correlated; the σ's account for it" },
-    Row { key: "lateral_slip", label: "Sideways slide in turns", meaning: "a skid-steer robot's slide outward of its turns, v_y = −k·v·ω, checked on every log; when found (or asked with --lateral-slip) estimated with the six parameters, whose σ then include not knowing k" },
+    Row { key: "lateral_slip", label: "Sideways slide in turns", meaning: "a skid-steer robot's slide outward of its turns, v_y = −k·v·ω, checked on every log; weighed in with the six parameters by the evidence for it (in full from about 4σ, or when asked with --lateral-slip), whose σ then include not knowing k" },
     Row { key: "consistency", label: "The two halves of the log", meaning: "each half calibrated alone; the difference compared with its σ" },
     Row { key: "covariance", label: "Covariance of the estimate", meaning: "the uncertainty of the six parameters and how they move together; its diagonal is σ²" },
     Row { key: "closed_form", label: "Closed-form solution", meaning: "the linear least-squares estimate the refinement started from" },
@@ -205,13 +205,17 @@ fn self_check(v: &Value) -> Markup {
 fn lateral_slip(v: &Value) -> Markup {
     let p = "/lateral_slip";
     let applied = v["applied"].as_bool().unwrap_or(false);
+    // Results written before the weighing have no weight: the slide was all or nothing.
+    let weight = v["weight"].as_f64().unwrap_or(1.0);
     html! {
         p {
             "k = " (json(&v["k"], &format!("{p}/k"))) " ± " (json(&v["sigma"], &format!("{p}/sigma"))) " s"
             @if let Some(k) = v["k"].as_f64() { " (a " (format!("{:.1}", k.atan().to_degrees())) "° slip angle at 1 rad/s)" }
             "; ℓx with the slide minus ℓx without: "
             @if let Some(d) = v["l_x_shift"].as_f64() { (num(&format!("{p}/l_x_shift"), d, 1e3, 2)) " mm" }
-            @if applied { "; estimated: the parameters and their σ include it." } @else { "; not estimated: the parameters are the differential-drive ones." }
+            @if applied && weight < 1.0 {
+                "; weighed in at " (format!("{:.0}", 100.0 * weight)) " % by its evidence: the parameters are the two models' mixture, and their σ include both and the difference between them."
+            } @else if applied { "; estimated: the parameters and their σ include it." } @else { "; not estimated: the parameters are the differential-drive ones." }
         }
     }
 }

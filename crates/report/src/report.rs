@@ -337,7 +337,14 @@ fn slide_line(slip: &LateralSlip) -> String {
         slip.significance(),
         slip.slip_angle_deg(1.0)
     );
-    if slip.applied {
+    if slip.applied && slip.weight < 1.0 {
+        format!(
+            "sideways slide in turns v_y = −k·v·ω weighed in at {:.0} %: {k}; without it ℓx would be {:+.1} mm off, with it in full {:+.1} mm; the σ above include both and their difference",
+            100.0 * slip.weight,
+            -1e3 * slip.weight * slip.l_x_shift,
+            1e3 * (1.0 - slip.weight) * slip.l_x_shift
+        )
+    } else if slip.applied {
         format!(
             "sideways slide in turns v_y = −k·v·ω estimated: {k}; without it ℓx would be {:+.1} mm off; the σ above include it",
             -1e3 * slip.l_x_shift

@@ -53,9 +53,18 @@ pub struct LateralSlip {
     pub turning_speed: f64,
     /// Median turn rate |ω| (rad/s) of the same samples.
     pub turn_rate: f64,
-    /// Whether the calibration's parameters and covariance are those of the model
-    /// with the slide (else it was only checked for).
+    /// Whether the calibration's parameters and covariance include the model with
+    /// the slide, in the share [`LateralSlip::weight`] (else it was only checked
+    /// for).
     pub applied: bool,
+    /// The share of the model with the slide in the calibration's estimate (0: the
+    /// six-parameter estimate, 1: the seven-parameter one; between, the two weighed
+    /// by the evidence for the slide, see [`SlideFit::blend`]).
+    pub weight: f64,
+    /// `k / σ` as the two models were weighed, with the solver's own σ of `k` (the
+    /// `sigma` recorded may be scaled afterwards, when the scan matcher's own error
+    /// shows every σ too small).
+    pub evidence: f64,
 }
 
 impl LateralSlip {
@@ -100,19 +109,63 @@ pub struct SlideFit {
 
 impl SlideFit {
     /// Replaces `calibration`'s estimate, covariance, verdicts and costs by the
-    /// joint ones and records the slide as applied.
+    /// joint ones and records the slide as applied (a [`SlideFit::blend`] of weight 1).
     pub fn apply(self, calibration: &mut Calibration) {
+        self.blend(calibration, 1.0);
+    }
+
+    /// Puts the two models into `calibration` (the six-parameter one), the model with
+    /// the slide at `weight` (clamped to 0 … 1) — the mixture of the two estimates
+    /// as two Gaussians: the mean `θ₆ + w·Δ` (`Δ` the slide's shifts, `θ₇ − θ₆`) and
+    /// the covariance `(1 − w)·C₆ + w·C₇ + w(1 − w)·Δ Δᵀ`, which holds both models'
+    /// σ and the difference between them. The verdicts are judged again; the cost
+    /// and reduced χ² are the model's of the larger weight. At weight 0 the slide is
+    /// only recorded as checked; at weight 1 the estimate is the joint one exactly.
+    pub fn blend(self, calibration: &mut Calibration, weight: f64) {
+        let w = if weight.is_finite() {
+            weight.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        if w == 0.0 {
+            calibration.lateral_slip = Some(LateralSlip {
+                applied: false,
+                weight: 0.0,
+                ..self.slip
+            });
+            return;
+        }
+        let (params, covariance) = if w == 1.0 {
+            (self.params, self.covariance)
+        } else {
+            let without = calibration.params.to_vector();
+            let d = self.slip.shifts;
+            let c6 = &calibration.covariance;
+            (
+                Params::from_vector(std::array::from_fn(|i| without[i] + w * d[i])),
+                std::array::from_fn(|a| {
+                    std::array::from_fn(|b| {
+                        (1.0 - w) * c6[a][b]
+                            + w * self.covariance[a][b]
+                            + w * (1.0 - w) * d[a] * d[b]
+                    })
+                }),
+            )
+        };
         let obs = &mut calibration.observability;
-        obs.rejudge(&self.params, &self.covariance);
-        obs.wheel_signs = wheel_signs(&self.params);
-        calibration.params = self.params;
-        calibration.j = self.params.j();
-        calibration.covariance = self.covariance;
-        calibration.cost_after = self.cost;
-        let dof = (3 * calibration.samples_used).saturating_sub(7).max(1);
-        calibration.reduced_chi2 = self.cost / dof as f64;
+        obs.rejudge(&params, &covariance);
+        obs.wheel_signs = wheel_signs(&params);
+        calibration.params = params;
+        calibration.j = params.j();
+        calibration.covariance = covariance;
+        if w >= 0.5 {
+            calibration.cost_after = self.cost;
+            let dof = (3 * calibration.samples_used).saturating_sub(7).max(1);
+            calibration.reduced_chi2 = self.cost / dof as f64;
+        }
         calibration.lateral_slip = Some(LateralSlip {
             applied: true,
+            weight: w,
             ..self.slip
         });
     }
@@ -297,6 +350,12 @@ pub fn fit_lateral_slip(
             turning_speed: median(speeds),
             turn_rate: median(rates),
             applied: false,
+            weight: 0.0,
+            evidence: if var_k > 0.0 {
+                x[6] / var_k.sqrt()
+            } else {
+                f64::INFINITY
+            },
         },
         cost,
     })
