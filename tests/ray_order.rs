@@ -113,10 +113,12 @@ fn the_real_logs_calibrate_the_same_with_their_rays_listed_the_other_way() {
         // −0.05σ. The chaos floor is higher than the module documentation's 0.33σ
         // (two units in the last place): with ranges changed by ±1 mm, the URG's
         // quantum, in a fifth of the readings (seven draws, the log itself among
-        // them), two draws differ by up to 1.13σ for exp1 (ℓx) and 1.55σ for exp2
-        // (r_L). Until stop 43 exp2's ℓx took one of two values 40 mm apart under
-        // such changes (the slide switched on at 2σ, its k at 2.1σ): weighed in by
-        // its evidence, it moves by 0.91σ at most, and is bounded with the rest.
+        // them), two draws differ by up to 0.92σ for exp1 (ℓy) and 1.34σ for exp2
+        // (ℓθ); 1.13σ and 1.55σ when the driver's repeated scans are redrawn too
+        // (they then pair the scans in the other phase of the stride). Until stop 43
+        // exp2's ℓx took one of two values 40 mm apart under such changes (the
+        // slide switched on at 2σ, its k at 2.1σ): weighed in by its evidence, it
+        // moves by 1.02σ at most, and is bounded with the rest.
         // The bounds are the chaos with a margin for what seven draws do not show.
         let bound = if name == "exp2.log" { 1.7 } else { 1.2 };
         let b = both_orders(name, &log);
