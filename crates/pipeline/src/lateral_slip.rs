@@ -23,10 +23,10 @@ pub const SIGNIFICANCE: f64 = 4.0;
 /// `|k| / σ` at which an outward slide weighs as much as no slide in the estimate
 /// ([`slide_weight`]), as a precaution: estimating a slide that is not there costs
 /// only σ (the estimate of the six stays unbiased), ignoring one that is there
-/// biases them. (Before the weighing, the slide was estimated in full from here.) On the simulated
-/// MinesRover (truth k = 0.05 s, 12 seeds × 120 s) estimating from 2σ instead of 4σ
-/// took the RMS error/σ of ℓx from 1.26 to 1.04 and of ℓθ from 1.91 to 1.44; no
-/// TurtleBot 4 log (no slide, 12 seeds, |k|/σ at most 0.9) estimated it.
+/// biases them. Before the weighing (stop 43) the slide was estimated in full from
+/// here: on the simulated MinesRover (truth k = 0.05 s, 12 seeds × 120 s) that from
+/// 2σ instead of 4σ took the RMS error/σ of ℓx from 1.26 to 1.04 and of ℓθ from 1.91
+/// to 1.44; no TurtleBot 4 log (no slide, 12 seeds, |k|/σ at most 0.9) estimated it.
 pub const PRECAUTION: f64 = 2.0;
 
 /// The share of the model with the slide in the estimate of [`SlideModel::Auto`]:
@@ -39,7 +39,7 @@ pub const PRECAUTION: f64 = 2.0;
 /// A switch at `PRECAUTION` instead made the estimate jump with the samples: the
 /// real MinesRover exp2 has `k` at 2.1σ, and redrawing a fifth of its ranges by
 /// ±1 mm put it on either side of 2σ, so that ℓx took one of two values 40 mm apart
-/// (`docs/benchmarks.md`, stop 42) while each value's σ claimed 11–26 mm. Weighed,
+/// while each value's σ claimed 11–26 mm (`docs/benchmarks.md`, stops 42 and 43). Weighed,
 /// the estimate and its covariance move continuously with `k`, and near the
 /// threshold the σ hold the difference between the two models.
 pub fn slide_weight(slip: &LateralSlip) -> f64 {
