@@ -84,9 +84,15 @@ pub struct Args {
     /// estimated from the residuals, which is what the reported σ assume).
     #[arg(long)]
     pub icp_covariance: bool,
+    /// Use every scan pair the log holds: the scans STRIDE apart from every scan, not
+    /// from every STRIDE-th (all phases of the pairing, calibrated together as
+    /// several logs of one laser). STRIDE times the matching (at most 8 phases), for
+    /// a laser pose whose σ is up to 2–3× smaller; one laser only.
+    #[arg(long)]
+    pub all_pairs: bool,
     /// Skid-steer robot: estimate the sideways slide in turns (v_y = −k·v·ω) as a
-    /// seventh parameter, always (by default it is estimated when the data show it).
-    /// Several logs of one laser share one slide; not with several lasers.
+    /// seventh parameter in full, always (by default it is weighed in by the evidence
+    /// for it). Several logs of one laser share one slide; not with several lasers.
     #[arg(long, conflicts_with = "no_lateral_slip")]
     pub lateral_slip: bool,
     /// Differential drive only: neither check for the sideways slide in turns nor
@@ -300,7 +306,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Ok(heading) => anyhow::Error::from(heading),
         Err(e) => crate::partial_args::with_hold_command(e),
     };
-    let (mut logs, mut checksums): (Vec<Log>, Vec<Option<(String, u64)>>) =
+    let (mut logs, checksums): (Vec<Log>, Vec<Option<(String, u64)>>) =
         inputs.into_iter().map(|(_, r)| (r.log, r.checksum)).unzip();
 
     let initial_params = input.nominal_with_laser(laser.as_ref())?;
@@ -364,6 +370,49 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             }
         }
     }
+
+    // --all-pairs: each log becomes its phases, calibrated together (one laser).
+    let (logs, paths, names, topics, mut checksums, setup) = if args.all_pairs {
+        if lasers > 1 {
+            anyhow::bail!(
+                "--all-pairs calibrates the phases of one laser's logs together; with \
+                 several lasers (--own-laser, several --scan-topic) calibrate each laser's \
+                 logs on their own"
+            );
+        }
+        let mut expanded = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        for ((((log, path), name), topic), checksum) in logs
+            .iter()
+            .zip(&paths)
+            .zip(&names)
+            .zip(&topics)
+            .zip(&checksums)
+        {
+            let stride = odocal_pipeline::phases::stride(log, &opts)?;
+            for (j, phase) in odocal_pipeline::phases::phases(log, stride)?
+                .into_iter()
+                .enumerate()
+            {
+                expanded.0.push(phase);
+                expanded.1.push(*path);
+                expanded
+                    .2
+                    .push(odocal_pipeline::phases::phase_name(name, j));
+                expanded.3.push(topic.clone());
+                expanded.4.push(checksum.clone());
+            }
+        }
+        let count = expanded.0.len();
+        let setup = LaserSetup {
+            of_log: vec![0; count],
+            ..setup
+        };
+        (
+            expanded.0, expanded.1, expanded.2, expanded.3, expanded.4, setup,
+        )
+    } else {
+        (logs, paths, names, topics, checksums, setup)
+    };
 
     let bar = Bar::for_stderr();
     let (mut outcome, mut report) = if let [log] = &logs[..] {

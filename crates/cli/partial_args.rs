@@ -125,10 +125,19 @@ pub fn with_hold_command(e: odocal_pipeline::PipelineError) -> anyhow::Error {
     }
     let mut words: Vec<String> = vec!["odocal".into()];
     words.extend(std::env::args().skip(1).map(|a| shell_word(&a)));
+    // Paired one scan in `stride`: every pair the log holds may determine the
+    // parameters without holding any (the real MinesRover logs, driven forward only,
+    // do; docs/benchmarks.md, stop 43).
+    let stride = e.stride();
+    let all_pairs = (stride > 1
+        && stride <= odocal_pipeline::phases::MAX_PHASES
+        && !words.iter().any(|w| w == "--all-pairs"))
+    .then(|| format!("{} --all-pairs", words.join(" ")));
     words.extend(holds.iter().map(|h| h.argument()));
     HoldRefusal {
         measure: holds.iter().any(|h| h.value.is_none()),
         command: words.join(" "),
+        all_pairs: all_pairs.map(|command| (stride, command)),
         refusal: e,
     }
     .into()
@@ -143,6 +152,9 @@ pub struct HoldRefusal {
     pub command: String,
     /// Some held value must be measured (`MEASURED` stands in the command).
     pub measure: bool,
+    /// With scans paired one in a stride above 1: the stride and the command that
+    /// uses every scan pair the log holds instead of holding parameters.
+    pub all_pairs: Option<(usize, String)>,
 }
 
 impl std::fmt::Display for HoldRefusal {
@@ -156,7 +168,16 @@ impl std::fmt::Display for HoldRefusal {
             f,
             "{}\nto calibrate the other parameters, run{measure}:\n  {}",
             self.refusal, self.command
-        )
+        )?;
+        if let Some((stride, command)) = &self.all_pairs {
+            write!(
+                f,
+                "\nor first, to use every scan pair the log holds (the scans {stride} apart \
+                 from every scan, not one in {stride}: {stride}× the matching), which may \
+                 determine them all without holding any, run:\n  {command}"
+            )?;
+        }
+        Ok(())
     }
 }
 

@@ -155,6 +155,18 @@ impl PipelineError {
         }
     }
 
+    /// The stride the refused calibration paired its scans at (through a data-fault
+    /// wrapper; 0 for other errors).
+    pub fn stride(&self) -> usize {
+        match self {
+            PipelineError::NotDetermined { diagnosis, .. } => diagnosis.stride,
+            PipelineError::DataFault { refusal, .. } | PipelineError::AlsoFound { refusal, .. } => {
+                refusal.stride()
+            }
+            _ => 0,
+        }
+    }
+
     /// The parameters to hold that the refusal proposes (through a data-fault wrapper).
     pub fn holds(&self) -> &[crate::refusal::Hold] {
         match self {

@@ -51,6 +51,7 @@ pub mod matcher_bias;
 pub mod matching;
 pub mod options;
 pub mod parallel;
+pub mod phases;
 mod progress;
 pub mod range_finder;
 pub mod range_scale;

@@ -38,6 +38,9 @@ pub struct Diagnosis {
     /// a heading not from the wheels, scan matching), not in the motion, so the
     /// refusal does not suggest `--fix` or `--prior`.
     pub no_hold: bool,
+    /// The stride the refused calibration paired its scans at (0: not known): above 1,
+    /// the pairs starting at the other scans were not used (`--all-pairs` uses them).
+    pub stride: usize,
 }
 
 /// A parameter to hold with `--fix`, with the value to hold it at when one is known.

@@ -136,7 +136,7 @@ fn first_guesses(
 }
 
 /// The time each scan stands for: its reference time (the timestamp without a sweep).
-fn reference_times(log: &Log) -> Vec<f64> {
+pub(crate) fn reference_times(log: &Log) -> Vec<f64> {
     (0..log.scans.len())
         .map(|i| {
             log.scans
@@ -617,6 +617,7 @@ pub(crate) fn refuse_poorly_determined(
                 caveat: None,
                 faults: None,
                 no_hold: unjudgeable.is_some() || !demoted.is_empty(),
+                stride: synced.stride,
             }),
         });
     }

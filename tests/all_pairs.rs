@@ -1,0 +1,93 @@
+//! `--all-pairs`: every scan pair a log holds, its phases calibrated together. The
+//! pairs starting at the scans a stride skips are fresh draws of the matching error:
+//! with them the laser pose's σ shrinks, the estimate stays within it, and a refusal
+//! of a log paired one scan in a stride offers the command.
+
+mod common;
+
+use common::{calibrate_json, cleanup, mines_log, odocal, simulated_log, stderr};
+
+/// σ of ℓx, ℓy, ℓθ in a results JSON.
+fn pose_sigma(v: &serde_json::Value) -> [f64; 3] {
+    std::array::from_fn(|i| v["sigma"][3 + i].as_f64().expect("σ"))
+}
+
+#[test]
+fn every_pair_shrinks_the_pose_sigma_and_keeps_the_truth_within_it() {
+    let (path, truth) = simulated_log("all-pairs", "turtlebot", 60.0, 41, |_| {});
+    let log = path.to_str().unwrap();
+    let one = calibrate_json(&[log, "--accept-weak"]);
+    let all = calibrate_json(&[log, "--accept-weak", "--all-pairs"]);
+    let stride = one["stride"].as_u64().expect("stride") as usize;
+    assert!(stride >= 2, "stride {stride}");
+    // One row per phase, named by the scan its pairs start from.
+    let rows = all["logs"].as_array().expect("a row per phase");
+    assert_eq!(rows.len(), stride);
+    for (j, row) in rows.iter().enumerate() {
+        let name = row["path"].as_str().unwrap();
+        assert!(
+            name.ends_with(&format!("pairs from scan {}", j + 1)),
+            "{name}"
+        );
+    }
+    let (n1, na) = (
+        one["samples_used"].as_u64().unwrap(),
+        all["samples_used"].as_u64().unwrap(),
+    );
+    assert!(na as f64 >= 0.8 * stride as f64 * n1 as f64, "{n1} → {na}");
+    let (s1, sa) = (pose_sigma(&one), pose_sigma(&all));
+    for i in 0..3 {
+        assert!(sa[i] < 0.8 * s1[i], "pose σ {i}: {} → {}", s1[i], sa[i]);
+    }
+    let names = ["r_l", "r_r", "b", "l_x", "l_y", "l_theta"];
+    for (i, name) in names.iter().enumerate() {
+        let e = (all[name].as_f64().unwrap() - truth[i]) / all["sigma"][i].as_f64().unwrap();
+        assert!(e.abs() < 3.0, "{name}: {e:+.2}σ");
+    }
+    cleanup(&path);
+}
+
+#[test]
+fn too_many_phases_and_several_lasers_are_refused_with_the_way_out() {
+    let (path, _) = simulated_log("all-pairs-refused", "turtlebot", 20.0, 42, |_| {});
+    let log = path.to_str().unwrap();
+    let o = odocal(&["calibrate", log, "--all-pairs", "--stride", "9"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--stride 8"), "{}", stderr(&o));
+    let o = odocal(&["calibrate", log, log, "--own-laser", "2", "--all-pairs"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("several lasers"), "{}", stderr(&o));
+    cleanup(&path);
+}
+
+#[test]
+fn the_real_forward_only_logs_are_offered_every_pair_and_gain_from_it() {
+    for name in ["exp1.log", "exp2.log"] {
+        let Some(path) = mines_log(name) else {
+            continue;
+        };
+        let log = path.to_str().unwrap();
+        // Refused (ℓx weak: no spins in place), with --all-pairs among the ways out.
+        let o = odocal(&["calibrate", log]);
+        let err = stderr(&o);
+        assert!(!o.status.success(), "{err}");
+        let offered = err
+            .lines()
+            .skip_while(|l| !l.starts_with("or first, to use every scan pair"))
+            .nth(1)
+            .unwrap_or_else(|| panic!("no --all-pairs command in: {err}"));
+        assert!(offered.trim_end().ends_with("--all-pairs"), "{offered}");
+        // Measured (stop 43): the pose σ 2.3–3.0× smaller with every pair.
+        let one = calibrate_json(&[log, "--accept-weak"]);
+        let all = calibrate_json(&[log, "--accept-weak", "--all-pairs"]);
+        let (s1, sa) = (pose_sigma(&one), pose_sigma(&all));
+        for i in 0..3 {
+            assert!(
+                sa[i] < s1[i] / 1.5,
+                "{name} pose σ {i}: {} → {}",
+                s1[i],
+                sa[i]
+            );
+        }
+    }
+}
