@@ -221,6 +221,52 @@ fn nominal_pose(l: odocal_bag::NominalLaser) -> NominalLaserPose {
     }
 }
 
+/// The logs to calibrate, one entry per laser's log, with the path each was read
+/// from, the name the messages give it, its scan topic and its input checksum.
+struct LogInputs<'a> {
+    logs: Vec<Log>,
+    paths: Vec<&'a std::path::Path>,
+    names: Vec<String>,
+    topics: Vec<Option<String>>,
+    checksums: Vec<Option<(String, u64)>>,
+}
+
+impl<'a> LogInputs<'a> {
+    /// `--all-pairs`: every log replaced by its phases ([`odocal_pipeline::phases`]),
+    /// each named by the scan its pairs start from, with its log's path, topic and
+    /// checksum.
+    fn into_phases(self, opts: &Options) -> anyhow::Result<Self> {
+        let mut out = LogInputs {
+            logs: Vec::new(),
+            paths: Vec::new(),
+            names: Vec::new(),
+            topics: Vec::new(),
+            checksums: Vec::new(),
+        };
+        for ((((log, path), name), topic), checksum) in self
+            .logs
+            .iter()
+            .zip(self.paths)
+            .zip(&self.names)
+            .zip(&self.topics)
+            .zip(&self.checksums)
+        {
+            let stride = odocal_pipeline::phases::stride(log, opts)?;
+            for (j, phase) in odocal_pipeline::phases::phases(log, stride)?
+                .into_iter()
+                .enumerate()
+            {
+                out.logs.push(phase);
+                out.paths.push(path);
+                out.names.push(odocal_pipeline::phases::phase_name(name, j));
+                out.topics.push(topic.clone());
+                out.checksums.push(checksum.clone());
+            }
+        }
+        Ok(out)
+    }
+}
+
 /// Runs `odocal calibrate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
@@ -342,7 +388,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     opts.solve.trim = args.trim.into();
     opts.solve.refine = !args.no_refine;
     opts.solve.constraints = constraints.shared;
-    let setup = LaserSetup {
+    let mut setup = LaserSetup {
         of_log: laser_of_log.clone(),
         nominal: other_nominal
             .iter()
@@ -371,8 +417,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     }
 
-    // --all-pairs: each log becomes its phases, calibrated together (one laser).
-    let (logs, paths, names, topics, mut checksums, setup) = if args.all_pairs {
+    let mut inputs = LogInputs {
+        logs,
+        paths,
+        names,
+        topics,
+        checksums,
+    };
+    if args.all_pairs {
         if lasers > 1 {
             anyhow::bail!(
                 "--all-pairs calibrates the phases of one laser's logs together; with \
@@ -380,39 +432,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                  logs on their own"
             );
         }
-        let mut expanded = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        for ((((log, path), name), topic), checksum) in logs
-            .iter()
-            .zip(&paths)
-            .zip(&names)
-            .zip(&topics)
-            .zip(&checksums)
-        {
-            let stride = odocal_pipeline::phases::stride(log, &opts)?;
-            for (j, phase) in odocal_pipeline::phases::phases(log, stride)?
-                .into_iter()
-                .enumerate()
-            {
-                expanded.0.push(phase);
-                expanded.1.push(*path);
-                expanded
-                    .2
-                    .push(odocal_pipeline::phases::phase_name(name, j));
-                expanded.3.push(topic.clone());
-                expanded.4.push(checksum.clone());
-            }
-        }
-        let count = expanded.0.len();
-        let setup = LaserSetup {
-            of_log: vec![0; count],
-            ..setup
-        };
-        (
-            expanded.0, expanded.1, expanded.2, expanded.3, expanded.4, setup,
-        )
-    } else {
-        (logs, paths, names, topics, checksums, setup)
-    };
+        inputs = inputs.into_phases(&opts)?;
+        setup.of_log = vec![0; inputs.logs.len()];
+    }
+    let LogInputs {
+        logs,
+        paths,
+        names,
+        topics,
+        mut checksums,
+    } = inputs;
 
     let bar = Bar::for_stderr();
     let (mut outcome, mut report) = if let [log] = &logs[..] {
