@@ -38,8 +38,8 @@ pub fn stride(log: &Log, opts: &Options) -> Result<usize, PipelineError> {
 }
 
 /// The phases of `log` paired at `stride`: phase `j` is the log without its first
-/// `j` scans (`j` = 0 … stride − 1; fewer when the log has fewer scans than that).
-/// Refused beyond [`MAX_PHASES`], which would hold the log that many times.
+/// `j` scans (`j` = 0 … stride − 1), as many as hold a pair (at least the log as it
+/// is). Refused beyond [`MAX_PHASES`], which would hold the log that many times.
 pub fn phases(log: &Log, stride: usize) -> Result<Vec<Log>, PipelineError> {
     if stride > MAX_PHASES {
         return Err(PipelineError::InvalidSetting(format!(
@@ -48,7 +48,8 @@ pub fn phases(log: &Log, stride: usize) -> Result<Vec<Log>, PipelineError> {
              log is paired {stride} scans apart: give `--stride {MAX_PHASES}` or less"
         )));
     }
-    let count = stride.clamp(1, log.scans.len().max(1));
+    // Phase j's first pair is scans j and j + stride.
+    let count = stride.min(log.scans.len().saturating_sub(stride)).max(1);
     Ok((0..count)
         .map(|j| {
             let mut phase = log.clone();
@@ -103,5 +104,8 @@ mod tests {
         assert!(err.contains("--stride 8"), "{err}");
         // A stride of 1 is one phase: the log as it is.
         assert_eq!(phases(&log_of(3), 1).unwrap().len(), 1);
+        // Only phases that hold a pair: 6 scans at stride 4 pair 0–4 and 1–5.
+        assert_eq!(phases(&log_of(6), 4).unwrap().len(), 2);
+        assert_eq!(phases(&log_of(3), 4).unwrap().len(), 1);
     }
 }
