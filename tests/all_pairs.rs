@@ -77,6 +77,20 @@ fn the_real_forward_only_logs_are_offered_every_pair_and_gain_from_it() {
             .nth(1)
             .unwrap_or_else(|| panic!("no --all-pairs command in: {err}"));
         assert!(offered.trim_end().ends_with("--all-pairs"), "{offered}");
+        // Under --json too, beside the command that holds parameters.
+        let o = odocal(&["calibrate", log, "--json"]);
+        assert!(!o.status.success());
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+        let command = v["all_pairs_command"]
+            .as_str()
+            .unwrap_or_else(|| panic!("{v}"));
+        assert!(command.ends_with("--json --all-pairs"), "{command}");
+        assert!(
+            v["suggested_command"]
+                .as_str()
+                .is_some_and(|c| c.contains("--fix")),
+            "{v}"
+        );
         // Measured (stop 43): the pose σ 2.3–3.0× smaller with every pair.
         let one = calibrate_json(&[log, "--accept-weak"]);
         let all = calibrate_json(&[log, "--accept-weak", "--all-pairs"]);

@@ -1,7 +1,9 @@
 //! A refusal under `--json`: one JSON object on stdout, so that a script reading the
 //! output gets the reason instead of nothing. `{"error": the message, "kind": what
 //! refused, "suggested_command": the same command with the flag the message asks
-//! for}` (the last only when the message asks for one); the exit code stays non-zero.
+//! for}` (the last only when the message asks for one); a refusal of a log paired one
+//! scan in a stride also gives `"all_pairs_command"`, the same command with
+//! `--all-pairs`, which the message offers first. The exit code stays non-zero.
 
 use crate::heading_refusal::HeadingRefusal;
 use crate::partial_args::HoldRefusal;
@@ -51,6 +53,9 @@ pub fn error_object(error: &anyhow::Error, args: &[String]) -> Value {
     } else if let Some(h) = hold {
         // The refusal's own command: the parameters to hold (MEASURED to fill in).
         object["suggested_command"] = h.command.clone().into();
+        if let Some((_, command)) = &h.all_pairs {
+            object["all_pairs_command"] = command.clone().into();
+        }
     } else if message.contains("leave out --use-receive-time")
         && args.iter().any(|a| a == "--use-receive-time")
     {
