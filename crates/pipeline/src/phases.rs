@@ -20,7 +20,7 @@
 
 use crate::error::PipelineError;
 use crate::options::Options;
-use crate::sync::default_stride;
+use crate::sync::chosen_stride;
 use odocal_log::Log;
 
 /// Phases at the most: a log is held once per phase in memory, and matched once.
@@ -28,13 +28,7 @@ pub const MAX_PHASES: usize = 8;
 
 /// The stride `log`'s scans are paired at with `opts` (the one the pipeline takes).
 pub fn stride(log: &Log, opts: &Options) -> Result<usize, PipelineError> {
-    match opts.stride {
-        Some(0) => Err(PipelineError::InvalidSetting(
-            "the stride must be at least 1".into(),
-        )),
-        Some(k) => Ok(k),
-        None => Ok(default_stride(&crate::run::reference_times(log))),
-    }
+    chosen_stride(opts.stride, &crate::run::reference_times(log))
 }
 
 /// The phases of `log` paired at `stride`: phase `j` is the log without its first

@@ -14,7 +14,7 @@ use crate::rejection::{MatchFailure, Rejection, RejectionCounts};
 use crate::samples::PairSample;
 use crate::sweep::{compensated_pairs, has_sweep, reference_time};
 use crate::sync::{
-    default_stride, scan_pairs, DiscardCounts, DiscardReason, EncoderTrack, ScanPair, SyncLimits,
+    chosen_stride, scan_pairs, DiscardCounts, DiscardReason, EncoderTrack, ScanPair, SyncLimits,
     WheelMotion,
 };
 use crate::synchronized::Synchronized;
@@ -158,15 +158,7 @@ pub fn synchronize_and_match(
     let t_sync = Instant::now();
     let scan_times = reference_times(log);
     let sweep = has_sweep(&log.scans);
-    let stride = match opts.stride {
-        Some(0) => {
-            return Err(PipelineError::InvalidSetting(
-                "the stride must be at least 1".into(),
-            ))
-        }
-        Some(k) => k,
-        None => default_stride(&scan_times),
-    };
+    let stride = chosen_stride(opts.stride, &scan_times)?;
     let encoder_times: Vec<f64> = log.encoders.iter().map(|e| e.t).collect();
     let limits = opts
         .limits

@@ -117,6 +117,21 @@ pub fn default_stride(scan_times: &[f64]) -> usize {
     }
 }
 
+/// The stride to pair scans taken at `scan_times` at: the one given, or
+/// [`default_stride`]; a stride of 0 is refused.
+pub fn chosen_stride(
+    given: Option<usize>,
+    scan_times: &[f64],
+) -> Result<usize, crate::PipelineError> {
+    match given {
+        Some(0) => Err(crate::PipelineError::InvalidSetting(
+            "the stride must be at least 1".into(),
+        )),
+        Some(k) => Ok(k),
+        None => Ok(default_stride(scan_times)),
+    }
+}
+
 /// Pairs of scans `stride` apart, not overlapping: (0, k), (k, 2k), … so that every
 /// scan used serves at most twice and consecutive samples chain into a trajectory.
 pub fn scan_pairs(scan_times: &[f64], stride: usize) -> Vec<ScanPair> {
