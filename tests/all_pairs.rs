@@ -105,3 +105,59 @@ fn the_real_forward_only_logs_are_offered_every_pair_and_gain_from_it() {
         }
     }
 }
+
+#[test]
+fn the_real_logs_given_in_phases_are_compared_and_their_spread_kept() {
+    let (Some(exp1), Some(exp2)) = (mines_log("exp1.log"), mines_log("exp2.log")) else {
+        return;
+    };
+    let (exp1, exp2) = (exp1.to_str().unwrap(), exp2.to_str().unwrap());
+    // Default pairing: each log leaves ℓx weak, and is compared on the other five.
+    let v = calibrate_json(&[exp1, exp2, "--accept-weak"]);
+    for row in v["logs"].as_array().expect("a row per log") {
+        assert_eq!(row["dof"].as_u64(), Some(5), "{row}");
+    }
+    // Each log's two halves leave more weak (measured: ℓx, ℓy in exp1's; b, ℓx, ℓy in
+    // exp2's), and are compared on the others instead of not at all.
+    for log in [exp1, exp2] {
+        let v = calibrate_json(&[log, "--accept-weak"]);
+        let h = &v["consistency"]["checked"];
+        let dof = h["dof"]
+            .as_u64()
+            .unwrap_or_else(|| panic!("{log}: {}", v["consistency"]));
+        assert!((3..6).contains(&dof), "{log}: {h}");
+        assert!(
+            h["sentence"].as_str().unwrap().contains("weak in a half"),
+            "{log}: {h}"
+        );
+    }
+    // Every pair: each log given compared as a whole (its phases together).
+    let v = calibrate_json(&[exp1, exp2, "--all-pairs"]);
+    let given = v["logs_given"].as_array().expect("a row per log given");
+    assert_eq!(given.len(), 2);
+    let b = v["b"].as_f64().unwrap();
+    let sigma_b = v["sigma"][2].as_f64().unwrap();
+    for row in given {
+        assert!(row["agree"].is_boolean(), "{row}");
+        // Measured (stop 44): the logs' b, 297.5 ± 1.4 and 308.7 ± 1.9 mm, differ by
+        // 4.7σ; the joint σ of b is widened to their spread, so that it covers both
+        // (it was 1.2 mm, a 4σ claim for each).
+        let own = row["own"]["b"].as_f64().unwrap();
+        assert!(
+            (own - b).abs() < 2.0 * sigma_b,
+            "{}: b {own} against the joint {b} ± {sigma_b}",
+            row["path"]
+        );
+    }
+    // The phases are compared through their log, and get no finding of their own.
+    for row in v["logs"].as_array().expect("a row per phase") {
+        assert!(row["agree"].is_null(), "{row}");
+    }
+    let checks = v["checks"].as_array().unwrap();
+    assert!(
+        checks
+            .iter()
+            .all(|c| !c["message"].as_str().unwrap().contains("pairs from scan")),
+        "{checks:?}"
+    );
+}

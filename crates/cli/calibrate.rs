@@ -229,6 +229,8 @@ struct LogInputs<'a> {
     names: Vec<String>,
     topics: Vec<Option<String>>,
     checksums: Vec<Option<(String, u64)>>,
+    /// With `--all-pairs`: which of `logs` are the phases of which log given.
+    groups: Vec<odocal_pipeline::LogPhases>,
 }
 
 impl<'a> LogInputs<'a> {
@@ -242,6 +244,7 @@ impl<'a> LogInputs<'a> {
             names: Vec::new(),
             topics: Vec::new(),
             checksums: Vec::new(),
+            groups: Vec::new(),
         };
         for ((((log, path), name), topic), checksum) in self
             .logs
@@ -252,6 +255,7 @@ impl<'a> LogInputs<'a> {
             .zip(&self.checksums)
         {
             let stride = odocal_pipeline::phases::stride(log, opts)?;
+            let first = out.logs.len();
             for (j, phase) in odocal_pipeline::phases::phases(log, stride)?
                 .into_iter()
                 .enumerate()
@@ -262,6 +266,10 @@ impl<'a> LogInputs<'a> {
                 out.topics.push(topic.clone());
                 out.checksums.push(checksum.clone());
             }
+            out.groups.push(odocal_pipeline::LogPhases {
+                name: name.clone(),
+                logs: (first..out.logs.len()).collect(),
+            });
         }
         Ok(out)
     }
@@ -423,6 +431,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         names,
         topics,
         checksums,
+        groups: Vec::new(),
     };
     if args.all_pairs {
         if lasers > 1 {
@@ -441,6 +450,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         names,
         topics,
         mut checksums,
+        groups,
     } = inputs;
 
     let bar = Bar::for_stderr();
@@ -452,7 +462,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (outcome, report)
     } else {
         let named: Vec<(&str, &Log)> = names.iter().map(String::as_str).zip(&logs).collect();
-        let joint = pool.install(|| calibrate_logs_with_lasers(&named, &setup, &opts, &bar))?;
+        let joint = pool.install(|| {
+            if groups.is_empty() {
+                calibrate_logs_with_lasers(&named, &setup, &opts, &bar)
+            } else {
+                odocal_pipeline::calibrate_log_phases(&named, &groups, &opts, &bar)
+            }
+        })?;
         let all: Vec<&Log> = logs.iter().collect();
         let mut report = build_joint_report(&paths, &names, &topics, &all, &opts, &joint);
         for (row, n) in report

@@ -6,7 +6,9 @@
 //! a sensor mounting that moved), even when each half, and the whole, look fine.
 
 use nalgebra::DMatrix;
-use odocal_solver::{calibrate, Calibration, Sample, SolveOptions, Verdict, PARAMETER_NAMES};
+use odocal_solver::{
+    calibrate, Calibration, Constraint, Sample, SolveOptions, Verdict, PARAMETER_NAMES,
+};
 use serde::Serialize;
 
 /// 99.73 % quantiles of χ² with 1 … 6 degrees of freedom (the "3σ" level).
@@ -70,57 +72,103 @@ pub fn check_halves(samples: &[Sample], options: &SolveOptions) -> Consistency {
         || solve(&samples[half..], "second"),
     ) {
         (Ok(a), Ok(b)) => match undetermined_half(&a, &b, options) {
-            Some(reason) => Consistency::NotAvailable { reason },
-            None => {
+            Err(reason) => Consistency::NotAvailable { reason },
+            Ok(weak) => {
                 let sum = std::array::from_fn(|i| {
                     std::array::from_fn(|j| a.covariance[i][j] + b.covariance[i][j])
                 });
-                Consistency::Checked(Box::new(compare(
-                    &a,
-                    &b,
-                    &sum,
-                    options,
-                    "the two halves of the log",
-                )))
+                let compared = leaving_out(options, &weak, &a);
+                let what = if weak.is_empty() {
+                    "the two halves of the log".to_string()
+                } else {
+                    format!(
+                        "the two halves of the log, on the parameters both determine well \
+                         (not {}: weak in a half),",
+                        weak.iter()
+                            .map(|&i| PARAMETER_NAMES[i])
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                };
+                Consistency::Checked(Box::new(compare(&a, &b, &sum, &compared, &what)))
             }
         },
         (Err(reason), _) | (_, Err(reason)) => Consistency::NotAvailable { reason },
     }
 }
 
-/// Why the halves cannot be compared, when one of them alone does not determine
-/// every free parameter well, or the two land on different signs of the radii (the
+/// The free parameters that a half leaves weak (compared on the others), or why the
+/// halves cannot be compared at all: a half that does not excite a free parameter or
+/// leaves every one weak, or halves that land on different signs of the radii (the
 /// mirror solution of reversed wheels): their covariances then describe a
 /// linearization that is not valid, and χ² of the difference means nothing (on
-/// 20–60 s logs such halves gave χ² in the tens of thousands).
-fn undetermined_half(a: &Calibration, b: &Calibration, options: &SolveOptions) -> Option<String> {
+/// 20–60 s logs such halves gave χ² in the tens of thousands). A weak parameter's
+/// marginal is left out; the others' are compared (the real MinesRover logs, driven
+/// without spins, leave ℓx and ℓy weak in a half, exp2 b too, and are compared on the
+/// other four, or three).
+fn undetermined_half(
+    a: &Calibration,
+    b: &Calibration,
+    options: &SolveOptions,
+) -> Result<Vec<usize>, String> {
+    let free: Vec<usize> = (0..6)
+        .filter(|&i| !options.constraints.is_held(i))
+        .collect();
+    let mut weak: Vec<usize> = Vec::new();
     for (half, name) in [(a, "first"), (b, "second")] {
-        let weak: Vec<&str> = half
-            .observability
-            .parameters
+        let verdict = |i: usize| half.observability.parameters[i].verdict;
+        let not_well: Vec<usize> = free
             .iter()
-            .enumerate()
-            .filter(|(i, p)| {
-                !options.constraints.is_held(*i) && p.verdict != Verdict::WellDetermined
-            })
-            .map(|(_, p)| p.name.as_str())
+            .copied()
+            .filter(|&i| verdict(i) != Verdict::WellDetermined)
             .collect();
-        if !weak.is_empty() {
-            return Some(format!(
+        if not_well.len() == free.len()
+            || not_well.iter().any(|&i| verdict(i) == Verdict::NotExcited)
+        {
+            let names: Vec<&str> = not_well
+                .iter()
+                .map(|&i| half.observability.parameters[i].name.as_str())
+                .collect();
+            return Err(format!(
                 "the {name} half alone does not determine {} well ({} samples): the log \
                  is too short, or its motion too uneven, for the two-halves check",
-                weak.join(", "),
+                names.join(", "),
                 half.samples_used
             ));
         }
+        for i in not_well {
+            if !weak.contains(&i) {
+                weak.push(i);
+            }
+        }
     }
+    weak.sort_unstable();
     let sign = |c: &Calibration| (c.params.r_l.signum(), c.params.r_r.signum());
-    (sign(a) != sign(b)).then(|| {
-        "the two halves alone land on opposite signs of the wheel radii (the mirror \
-         solution): each half is too short to tell them apart, so the two-halves check \
-         is left out"
-            .to_string()
-    })
+    if sign(a) != sign(b) {
+        return Err(
+            "the two halves alone land on opposite signs of the wheel radii (the \
+                    mirror solution): each half is too short to tell them apart, so the \
+                    two-halves check is left out"
+                .to_string(),
+        );
+    }
+    Ok(weak)
+}
+
+/// `options` with the parameters `left_out` counting as held (at `at`'s values), so
+/// that [`compare`] compares the others' marginal: the parameters one side leaves
+/// weak.
+pub(crate) fn leaving_out(
+    options: &SolveOptions,
+    left_out: &[usize],
+    at: &Calibration,
+) -> SolveOptions {
+    let values = at.params.to_vector();
+    let mut o = *options;
+    for &i in left_out {
+        o.constraints.0[i] = Constraint::Held(values[i]);
+    }
+    o
 }
 
 /// Compares `a` with `b` given the covariance of their difference; `what` names the
@@ -308,32 +356,54 @@ mod tests {
     }
 
     #[test]
-    fn a_half_that_does_not_determine_every_parameter_is_not_compared() {
+    fn a_half_that_leaves_a_parameter_weak_is_compared_on_the_others() {
         let robot = robot();
         let opts = SolveOptions::default();
         let samples = drive(&robot, &robot);
         let solve = |part: &[Sample]| calibrate(part, &opts).expect("a half calibrates");
         let (first, second) = (solve(&samples[..200]), solve(&samples[200..]));
-        assert_eq!(undetermined_half(&first, &second, &opts), None);
-        // A half with a weak parameter: its σ do not describe its error.
+        assert_eq!(undetermined_half(&first, &second, &opts), Ok(vec![]));
+        // A half with a weak parameter: left out, the others compared.
         let mut weak = second.clone();
         weak.observability.parameters[3].verdict = Verdict::Weak;
-        let reason = undetermined_half(&first, &weak, &opts).expect("not compared");
+        assert_eq!(undetermined_half(&first, &weak, &opts), Ok(vec![3]));
+        // ... and not named when held.
+        let mut held = opts;
+        held.constraints.0[3] = odocal_solver::Constraint::Held(0.1);
+        assert_eq!(undetermined_half(&first, &weak, &held), Ok(vec![]));
+        // Left out, the parameter counts as held for the comparison: one fewer degree
+        // of freedom, no z for it.
+        let sum = std::array::from_fn(|i| {
+            std::array::from_fn(|j| first.covariance[i][j] + second.covariance[i][j])
+        });
+        let h = compare(
+            &first,
+            &second,
+            &sum,
+            &leaving_out(&opts, &[3], &first),
+            "x",
+        );
+        assert_eq!((h.dof, h.z[3], h.sigma[3]), (5, 0.0, 0.0));
+        // A parameter a half does not excite, or every parameter weak: not compared.
+        let mut unexcited = second.clone();
+        unexcited.observability.parameters[3].verdict = Verdict::NotExcited;
+        let reason = undetermined_half(&first, &unexcited, &opts).expect_err("not compared");
         assert!(
             reason.contains("second half")
                 && reason.contains("l_x")
                 && reason.contains("too short"),
             "{reason}"
         );
-        // ... unless that parameter is held.
-        let mut held = opts;
-        held.constraints.0[3] = odocal_solver::Constraint::Held(0.1);
-        assert_eq!(undetermined_half(&first, &weak, &held), None);
+        let mut all_weak = second.clone();
+        for p in all_weak.observability.parameters.iter_mut() {
+            p.verdict = Verdict::Weak;
+        }
+        assert!(undetermined_half(&all_weak, &second, &opts).is_err());
         // A half on the mirror solution (reversed wheels).
         let mut mirror = second;
         mirror.params.r_l = -mirror.params.r_l;
         mirror.params.r_r = -mirror.params.r_r;
-        let reason = undetermined_half(&first, &mirror, &opts).expect("not compared");
+        let reason = undetermined_half(&first, &mirror, &opts).expect_err("not compared");
         assert!(reason.contains("opposite signs"), "{reason}");
     }
 

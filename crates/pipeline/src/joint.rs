@@ -8,7 +8,7 @@
 
 use crate::consistency::Consistency;
 use crate::error::PipelineError;
-use crate::finding::Finding;
+use crate::finding::{Finding, FindingKind};
 use crate::lasers::{comparison_options, solve, LaserSetup, Solved};
 use crate::log_agreement::{check_log, information_shares};
 use crate::options::{Options, MIN_SAMPLES};
@@ -19,7 +19,7 @@ use crate::self_check::MatchSelfCheck;
 use crate::sync::DiscardCounts;
 use crate::synchronized::Synchronized;
 use odocal_log::Log;
-use odocal_solver::{LasersCalibration, Sample};
+use odocal_solver::{Calibration, LasersCalibration, Sample, SolveOptions};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -59,6 +59,34 @@ pub struct JointOutcome {
     /// With more than one laser: the joint estimate with every laser's ℓ (the
     /// `joint` outcome's calibration is the first laser's view of it).
     pub lasers: Option<LasersCalibration>,
+    /// With the phases of several logs ([`calibrate_log_phases`]): per log given, its
+    /// phases' estimate together against the joint one; empty otherwise.
+    pub phase_groups: Vec<PhaseGroupCheck>,
+}
+
+/// The phases of one log given (`--all-pairs`, [`crate::phases`]): the logs of a
+/// joint calibration that are that log paired from different scans.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LogPhases {
+    /// The log's name as given (its path).
+    pub name: String,
+    /// Its phases: positions in the joint calibration's logs.
+    pub logs: Vec<usize>,
+}
+
+/// One log given, its phases solved together, against the joint estimate of every
+/// log's phases.
+#[derive(Debug, Clone)]
+pub struct PhaseGroupCheck {
+    /// The log's name as given.
+    pub name: String,
+    /// Its phases: positions in the joint calibration's logs.
+    pub logs: Vec<usize>,
+    /// The estimate of its phases together (weak parameters accepted: never judged,
+    /// only compared).
+    pub calibration: Calibration,
+    /// Its estimate against the joint one ([`check_log`]).
+    pub agreement: Consistency,
 }
 
 /// Why [`calibrate_logs`] failed.
@@ -116,6 +144,40 @@ pub fn calibrate_logs_with_lasers(
     opts: &Options,
     progress: &dyn Progress,
 ) -> Result<JointOutcome, JointError> {
+    calibrate_joint(logs, lasers, &[], opts, progress)
+}
+
+/// [`calibrate_logs`] for the phases of one or several logs of one laser
+/// (`--all-pairs`): `logs` are every log's phases ([`crate::phases`]), `groups` says
+/// which are the phases of which log. Besides each phase, each log given (its phases
+/// solved together) is compared with the joint estimate when there are several: a
+/// phase alone rarely determines every parameter, and the logs' disagreement is what
+/// the comparison is for.
+pub fn calibrate_log_phases(
+    logs: &[(&str, &Log)],
+    groups: &[LogPhases],
+    opts: &Options,
+    progress: &dyn Progress,
+) -> Result<JointOutcome, JointError> {
+    calibrate_joint(
+        logs,
+        &LaserSetup::one_laser(logs.len()),
+        groups,
+        opts,
+        progress,
+    )
+}
+
+/// The joint calibration: [`calibrate_logs_with_lasers`], with each of `groups` (the
+/// phases of one log; empty: none) compared with the joint estimate as one log when
+/// there are several groups.
+fn calibrate_joint(
+    logs: &[(&str, &Log)],
+    lasers: &LaserSetup,
+    groups: &[LogPhases],
+    opts: &Options,
+    progress: &dyn Progress,
+) -> Result<JointOutcome, JointError> {
     // Numbered densely from the first log's laser, whatever numbers were given.
     let laser_of_log = crate::lasers::laser_indices(&lasers.of_log);
     let mut outcomes = Vec::with_capacity(logs.len());
@@ -147,42 +209,20 @@ pub fn calibrate_logs_with_lasers(
             })
         })
         .collect();
-    let samples = joint_samples(&outcomes, opts);
-    let mut synced = merged(&outcomes);
-    // As for one log: matches along a corridor do not count toward the minimum.
-    let usable = samples
-        .iter()
-        .filter(|s| s.free_direction.is_none())
-        .count();
-    if usable < MIN_SAMPLES {
-        return Err(JointError::Joint(PipelineError::TooFewSamples {
-            usable,
-            pairs: synced.pairs,
-            needed: MIN_SAMPLES,
-            discarded: synced.discarded,
-            match_rejections: synced.match_rejections,
-            scan_returns: synced.scan_returns,
-        }));
-    }
-    let solve_options = crate::matcher_bias::with_matcher_bias(opts.solve_options(), &synced);
-    let laser_of: Vec<usize> = outcomes
-        .iter()
-        .zip(&laser_of_log)
-        .flat_map(|(o, &k)| std::iter::repeat_n(k, o.synced.samples.len()))
-        .collect();
-    let mut solved = solve(&samples, &laser_of, &solve_options, &lasers.constraints)
-        .map_err(|e| JointError::Joint(PipelineError::from(e).with_faults(&health)))?;
+    let all: Vec<&Outcome> = outcomes.iter().collect();
+    let Together {
+        samples,
+        mut synced,
+        solve_options,
+        solved,
+    } = solve_together(&all, &laser_of_log, lasers, opts).map_err(|e| {
+        // Too few samples together: each log's own findings were already given.
+        JointError::Joint(match e {
+            e @ PipelineError::TooFewSamples { .. } => e,
+            e => e.with_faults(&health),
+        })
+    })?;
     if solved.lasers.is_none() {
-        // One robot, one slide: the logs' samples together determine `k` better than
-        // any one log, and a slide left out of the joint model biases ℓx there as it
-        // does in one log (the MinesRover's logs: ℓx 121 ± 8 mm without it, against
-        // 141 ± 17 mm from the first log alone with it).
-        crate::lateral_slip::check_and_apply(
-            &mut solved.first,
-            &samples,
-            &solve_options,
-            opts.lateral_slip,
-        );
         health.extend(
             crate::lateral_slip::finding(&solved.first, opts.lateral_slip).map(|mut f| {
                 f.message = format!("the logs together: {}", f.message);
@@ -204,7 +244,24 @@ pub fn calibrate_logs_with_lasers(
         .iter()
         .zip(&outcomes)
         .zip(&laser_of_log)
-        .map(|(((name, _), o), &k)| {
+        .enumerate()
+        .map(|(index, (((name, _), o), &k))| {
+            // With several logs given in phases, each log given is compared (its
+            // phases together), not each phase: a phase against the estimate of
+            // other logs mixes its own matching noise with the logs' difference.
+            if let Some(g) = groups
+                .iter()
+                .find(|g| g.logs.contains(&index))
+                .filter(|_| groups.len() > 1)
+            {
+                return Consistency::NotAvailable {
+                    reason: format!(
+                        "{name} is a phase of {}: compared with the joint estimate together \
+                         with that log's other phases",
+                        g.name
+                    ),
+                };
+            }
             let view = solved.view(k);
             let alone =
                 solved.lasers.is_some() && laser_of_log.iter().filter(|&&j| j == k).count() == 1;
@@ -213,6 +270,14 @@ pub fn calibrate_logs_with_lasers(
             check_log(&o.calibration, &view, &compared, name, alone)
         })
         .collect();
+    let phase_groups = if groups.len() > 1 {
+        groups
+            .iter()
+            .map(|g| phase_group_check(g, &outcomes, &solved.first, &solve_options, opts))
+            .collect::<Result<Vec<_>, _>>()?
+    } else {
+        Vec::new()
+    };
     let Solved {
         first: mut calibration,
         mut lasers,
@@ -230,6 +295,25 @@ pub fn calibrate_logs_with_lasers(
                 .for_each(|v| *v *= factor * factor);
         }
     }
+    if lasers.is_none() {
+        // Logs that disagree widen the joint σ to their spread: the logs given when
+        // they are phases, else each log.
+        let compared: Vec<(&Calibration, &Consistency)> = if phase_groups.is_empty() {
+            outcomes
+                .iter()
+                .map(|o| &o.calibration)
+                .zip(&agreements)
+                .collect()
+        } else {
+            phase_groups
+                .iter()
+                .map(|g| (&g.calibration, &g.agreement))
+                .collect()
+        };
+        if let Some(sentence) = crate::log_agreement::widen_to_spread(&mut calibration, &compared) {
+            health.push(Finding::warning(FindingKind::LogAgreement, sentence));
+        }
+    }
     let calibration =
         match refuse_poorly_determined(calibration, &synced, &samples, &solve_options, opts) {
             Ok(c) => c,
@@ -237,7 +321,7 @@ pub fn calibrate_logs_with_lasers(
                 // Logs of different robots (or mountings) make one model fit none of them:
                 // the residuals grow and the joint verdicts weaken. Name the logs that
                 // disagree rather than ask for more driving.
-                let disagreeing: Vec<(usize, String)> = agreements
+                let mut disagreeing: Vec<(usize, String)> = agreements
                     .iter()
                     .enumerate()
                     .filter_map(|(i, a)| match a {
@@ -245,6 +329,13 @@ pub fn calibrate_logs_with_lasers(
                         _ => None,
                     })
                     .collect();
+                // A log given whose phases together disagree: named by its first phase.
+                disagreeing.extend(phase_groups.iter().filter_map(|g| match &g.agreement {
+                    Consistency::Checked(h) if !h.agree => {
+                        Some((g.logs.first().copied().unwrap_or(0), h.sentence.clone()))
+                    }
+                    _ => None,
+                }));
                 return Err(if disagreeing.is_empty() {
                     JointError::Joint(refusal.with_faults(&health))
                 } else {
@@ -252,7 +343,11 @@ pub fn calibrate_logs_with_lasers(
                     let which: Vec<usize> = disagreeing.iter().map(|(i, _)| *i).collect();
                     let mut sentences: Vec<String> =
                         disagreeing.into_iter().map(|(_, s)| s).collect();
-                    sentences.extend(own_laser_hint(&names, &which, &laser_of_log));
+                    // Phases are not logs to give a laser of their own (`--own-laser`
+                    // counts the logs given).
+                    if groups.is_empty() {
+                        sentences.extend(own_laser_hint(&names, &which, &laser_of_log));
+                    }
                     JointError::Disagree {
                         sentences: sentences.join("; "),
                         refusal,
@@ -283,6 +378,19 @@ pub fn calibrate_logs_with_lasers(
             }
         })
         .collect();
+    let consistency = Consistency::NotAvailable {
+        reason: match groups {
+            // Measured (stop 44): the halves of one log in phases, at every pair's σ,
+            // differ on 13 of 30 simulated TurtleBot 4 logs, by the range bias that
+            // drifts with time, which the σ with the range scale already cover.
+            [one] if one.logs.len() == outcomes.len() => "one log in phases: each phase's \
+                own estimate is compared with the joint one instead"
+                .into(),
+            _ => "several logs: each log's own estimate is compared with the joint one \
+                  instead"
+                .into(),
+        },
+    };
     let mut timing = outcomes.iter().fold(Timing::default(), |a, o| Timing {
         parse: a.parse + o.timing.parse,
         sync: a.sync + o.timing.sync,
@@ -303,11 +411,7 @@ pub fn calibrate_logs_with_lasers(
         calibration,
         offset: None,
         timing,
-        consistency: Consistency::NotAvailable {
-            reason: "several logs: each log's own estimate is compared with the joint one \
-                     instead"
-                .into(),
-        },
+        consistency,
     };
     Ok(JointOutcome {
         logs: outcomes,
@@ -315,6 +419,112 @@ pub fn calibrate_logs_with_lasers(
         contributions,
         laser_of_log,
         lasers,
+        phase_groups,
+    })
+}
+
+/// The samples of several logs' outcomes solved together.
+struct Together {
+    /// Every log's solver samples, in log order.
+    samples: Vec<Sample>,
+    /// The logs' samples and discards together ([`merged`]).
+    synced: Synchronized,
+    /// The options the solve ran with (the matcher's bias included).
+    solve_options: SolveOptions,
+    /// The estimate (with one laser, the sideways slide weighed in).
+    solved: Solved,
+}
+
+/// Solves `outcomes`' samples together: `laser_of_log` is each outcome's laser (dense
+/// from 0), `lasers` their first guesses and constraints. Refused with fewer than
+/// [`MIN_SAMPLES`] usable samples.
+fn solve_together(
+    outcomes: &[&Outcome],
+    laser_of_log: &[usize],
+    lasers: &LaserSetup,
+    opts: &Options,
+) -> Result<Together, PipelineError> {
+    let samples = joint_samples(outcomes, opts);
+    let synced = merged(outcomes);
+    // As for one log: matches along a corridor do not count toward the minimum.
+    let usable = samples
+        .iter()
+        .filter(|s| s.free_direction.is_none())
+        .count();
+    if usable < MIN_SAMPLES {
+        return Err(synced.too_few_samples(usable));
+    }
+    let solve_options = crate::matcher_bias::with_matcher_bias(opts.solve_options(), &synced);
+    let laser_of: Vec<usize> = outcomes
+        .iter()
+        .zip(laser_of_log)
+        .flat_map(|(o, &k)| std::iter::repeat_n(k, o.synced.samples.len()))
+        .collect();
+    let mut solved = solve(&samples, &laser_of, &solve_options, &lasers.constraints)?;
+    if solved.lasers.is_none() {
+        // One robot, one slide: the logs' samples together determine `k` better than
+        // any one log, and a slide left out of the joint model biases ℓx there as it
+        // does in one log (the MinesRover's logs: ℓx 121 ± 8 mm without it, against
+        // 141 ± 17 mm from the first log alone with it).
+        crate::lateral_slip::check_and_apply(
+            &mut solved.first,
+            &samples,
+            &solve_options,
+            opts.lateral_slip,
+        );
+    }
+    Ok(Together {
+        samples,
+        synced,
+        solve_options,
+        solved,
+    })
+}
+
+/// The log `group` given, its phases (`outcomes` at `group.logs`) solved together as
+/// a log is alone (the slide weighed in, σ scaled by the matcher's own error, the
+/// verdicts judged with weak parameters accepted), compared with the joint estimate
+/// `joint` (solved with `solve_options`).
+fn phase_group_check(
+    group: &LogPhases,
+    outcomes: &[Outcome],
+    joint: &Calibration,
+    solve_options: &SolveOptions,
+    opts: &Options,
+) -> Result<PhaseGroupCheck, JointError> {
+    let members: Vec<&Outcome> = group.logs.iter().filter_map(|&i| outcomes.get(i)).collect();
+    let own = Options {
+        accept_weak: true,
+        ..opts.clone()
+    };
+    let failed = |source: PipelineError| JointError::Log {
+        index: group.logs.first().copied().unwrap_or(0),
+        name: format!("{} (its phases together)", group.name),
+        source,
+    };
+    let zeros = vec![0; members.len()];
+    let t = solve_together(
+        &members,
+        &zeros,
+        &LaserSetup::one_laser(members.len()),
+        &own,
+    )
+    .map_err(failed)?;
+    let mut calibration = t.solved.first;
+    if let Some(check) = &t.synced.match_self_check {
+        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
+        odocal_solver::inflate_sigma(&mut calibration, factor);
+    }
+    let calibration =
+        refuse_poorly_determined(calibration, &t.synced, &t.samples, &t.solve_options, &own)
+            .map_err(failed)?;
+    let name = format!("{} (its {} phases together)", group.name, members.len());
+    let agreement = check_log(&calibration, joint, solve_options, &name, false);
+    Ok(PhaseGroupCheck {
+        name: group.name.clone(),
+        logs: group.logs.clone(),
+        calibration,
+        agreement,
     })
 }
 
@@ -360,7 +570,7 @@ fn sliding_logs(logs: &[(&str, &Log)], outcomes: &[Outcome]) -> Option<String> {
 
 /// Every log's solver samples, in log order, each log with its own read-time noise,
 /// and the logs' scan times moved apart so that no two logs share a scan.
-fn joint_samples(outcomes: &[Outcome], opts: &Options) -> Vec<Sample> {
+fn joint_samples(outcomes: &[&Outcome], opts: &Options) -> Vec<Sample> {
     let mut samples = Vec::new();
     let mut next_start = 0.0;
     for o in outcomes {
@@ -389,7 +599,7 @@ fn joint_samples(outcomes: &[Outcome], opts: &Options) -> Vec<Sample> {
 
 /// The logs' samples and discards together (stride, limits, ticks and clock offset
 /// of the first log: each log's own are in its outcome).
-fn merged(outcomes: &[Outcome]) -> Synchronized {
+fn merged(outcomes: &[&Outcome]) -> Synchronized {
     let mut discarded = DiscardCounts::default();
     for o in outcomes {
         for (k, n) in &o.synced.discarded.0 {
@@ -441,7 +651,7 @@ fn merged(outcomes: &[Outcome]) -> Synchronized {
 
 /// The logs' scan-matching self-checks pooled: RMS errors weighted by the triples
 /// that closed in each log (`None` when no log had enough).
-fn pooled_self_check(outcomes: &[Outcome]) -> Option<MatchSelfCheck> {
+fn pooled_self_check(outcomes: &[&Outcome]) -> Option<MatchSelfCheck> {
     let checks: Vec<&MatchSelfCheck> = outcomes
         .iter()
         .filter_map(|o| o.synced.match_self_check.as_ref())

@@ -72,7 +72,8 @@ pub use estimate::Estimate;
 pub use finding::{Finding, FindingKind, Severity};
 pub use input_files::InputFiles;
 pub use joint::{
-    calibrate_logs, calibrate_logs_with_lasers, Contribution, JointError, JointOutcome,
+    calibrate_log_phases, calibrate_logs, calibrate_logs_with_lasers, Contribution, JointError,
+    JointOutcome, LogPhases, PhaseGroupCheck,
 };
 pub use lasers::{laser_indices, LaserSetup};
 pub use lateral_slip::SlideModel;

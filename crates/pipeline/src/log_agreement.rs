@@ -4,7 +4,7 @@
 //! two-halves check's rules ([`crate::consistency`]); and the share of the
 //! information on each parameter that each log brings.
 
-use crate::consistency::{compare, Consistency, HalvesCheck, Z_LIMIT};
+use crate::consistency::{compare, leaving_out, Consistency, HalvesCheck, Z_LIMIT};
 use nalgebra::DMatrix;
 use odocal_solver::{Calibration, SolveOptions, Verdict, PARAMETER_NAMES};
 
@@ -12,9 +12,15 @@ use odocal_solver::{Calibration, SolveOptions, Verdict, PARAMETER_NAMES};
 /// names the log in the sentence. With `own_covariance` the difference is judged by
 /// the log's own covariance (conservative: for a log that is the only one of its
 /// laser in a joint solve of several lasers, whose `C_log − C_joint` is nearly
-/// singular and no longer the difference's covariance). A log that alone does not determine every free
-/// parameter well, or lands on the mirror solution, is not compared (the reason is
-/// given): its covariance would describe a linearization that is not valid.
+/// singular and no longer the difference's covariance).
+///
+/// A log that alone leaves a free parameter weak is compared on the parameters it
+/// determines well (their marginal covariance), the weak ones named and left out:
+/// two real logs of one rover without spins in place, whose ℓx is weak in each,
+/// differ in b by 2–3σ, which no comparison showed when a weak ℓx left the whole log
+/// out. A log that does not excite a parameter at all, determines none well, or
+/// lands on the mirror solution is not compared (the reason is given): its
+/// covariance would describe a linearization that is not valid.
 pub fn check_log(
     log: &Calibration,
     joint: &Calibration,
@@ -22,20 +28,38 @@ pub fn check_log(
     name: &str,
     own_covariance: bool,
 ) -> Consistency {
-    let weak: Vec<&str> = log
-        .observability
-        .parameters
-        .iter()
-        .enumerate()
-        .filter(|(i, p)| !options.constraints.is_held(*i) && p.verdict != Verdict::WellDetermined)
-        .map(|(_, p)| p.name.as_str())
+    let free: Vec<usize> = (0..6)
+        .filter(|&i| !options.constraints.is_held(i))
         .collect();
-    if !weak.is_empty() {
+    let verdict = |i: usize| log.observability.parameters[i].verdict;
+    let names_of = |which: &[usize]| -> String {
+        which
+            .iter()
+            .map(|&i| log.observability.parameters[i].name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let unexcited: Vec<usize> = free
+        .iter()
+        .copied()
+        .filter(|&i| verdict(i) == Verdict::NotExcited)
+        .collect();
+    let weak: Vec<usize> = free
+        .iter()
+        .copied()
+        .filter(|&i| verdict(i) == Verdict::Weak)
+        .collect();
+    if !unexcited.is_empty() || weak.len() == free.len() {
+        let missing: Vec<usize> = free
+            .iter()
+            .copied()
+            .filter(|&i| verdict(i) != Verdict::WellDetermined)
+            .collect();
         return Consistency::NotAvailable {
             reason: format!(
                 "{name} alone does not determine {} well ({} samples), so its own estimate \
                  is not compared with the joint one; its samples count only in the joint fit",
-                weak.join(", "),
+                names_of(&missing),
                 log.samples_used
             ),
         };
@@ -49,13 +73,23 @@ pub fn check_log(
             ),
         };
     }
-    let what = format!("{name} and the joint estimate");
+    // The weak parameters are left out: the comparison is over the others' marginal.
+    let compared = leaving_out(options, &weak, joint);
+    let what = if weak.is_empty() {
+        format!("{name} and the joint estimate")
+    } else {
+        format!(
+            "{name} and the joint estimate, on the parameters the log alone determines \
+             well (not {}: weak in it),",
+            names_of(&weak)
+        )
+    };
     let covariance = if own_covariance {
         log.covariance
     } else {
-        difference_covariance(log, joint, options)
+        difference_covariance(log, joint, &compared)
     };
-    let mut check = compare(log, joint, &covariance, options, &what);
+    let mut check = compare(log, joint, &covariance, &compared, &what);
     if !check.agree {
         check.sentence = disagreement(&what, &check);
     }
@@ -162,6 +196,91 @@ pub fn information_shares(logs: &[&Calibration]) -> Vec<[f64; 6]> {
             })
         })
         .collect()
+}
+
+/// The joint estimate's σ widened where the logs disagree. For each parameter that
+/// some log's comparison found beyond 3σ, the `K` logs that determine it well give
+/// the external error of their weighted mean around the joint value θ: `σ_ext =
+/// √(χ²/(K − 1)) / √(Σ 1/σₖ²)`, `χ² = Σ (θₖ − θ)²/σₖ²` (the weighted mean's σ scaled
+/// by the Birge ratio); when `σ_ext` is above the joint σ, the parameter's row and
+/// column of the covariance are scaled up to it (correlations kept) and the verdicts
+/// judged again. Logs that disagree beyond their σ say that their σ leave an error
+/// out (or that they are not one robot, which their warnings say); the joint σ would
+/// then claim a precision that no log shows: two real logs of one rover whose b
+/// differ by 4.7σ (297.5 ± 1.4 and 308.7 ± 1.9 mm with every scan pair) gave a joint
+/// b of 302.2 ± 1.2 mm. The joint σ is the reference, not the product: its noise
+/// level, estimated on the logs together, may already have grown with their
+/// disagreement.
+///
+/// `logs` pairs each log's own estimate with its comparison. Returns the widened
+/// parameters' sentence, `None` when nothing was widened.
+pub fn widen_to_spread(
+    joint: &mut Calibration,
+    logs: &[(&Calibration, &Consistency)],
+) -> Option<String> {
+    let disagreeing: Vec<usize> = (0..6)
+        .filter(|&p| {
+            logs.iter().any(|(_, a)| match a {
+                Consistency::Checked(h) => !h.agree && h.z[p].abs() > Z_LIMIT,
+                Consistency::NotAvailable { .. } => false,
+            })
+        })
+        .collect();
+    let joint_values = joint.params.to_vector();
+    let mut ratios = [1.0; 6];
+    let mut said = Vec::new();
+    for &p in &disagreeing {
+        // The logs that determine p well (their comparison included it).
+        let own: Vec<(f64, f64)> = logs
+            .iter()
+            .filter(|(c, a)| {
+                matches!(a, Consistency::Checked(h) if h.sigma[p] > 0.0)
+                    && c.observability.parameters[p].verdict == Verdict::WellDetermined
+            })
+            .map(|(c, _)| (c.params.to_vector()[p], c.covariance[p][p]))
+            .filter(|(_, v)| v.is_finite() && *v > 0.0)
+            .collect();
+        if own.len() < 2 {
+            continue;
+        }
+        let chi2: f64 = own
+            .iter()
+            .map(|(v, var)| (v - joint_values[p]).powi(2) / var)
+            .sum();
+        let weight: f64 = own.iter().map(|(_, var)| 1.0 / var).sum();
+        let external = (chi2 / (own.len() - 1) as f64 / weight).sqrt();
+        let sigma = joint.covariance[p][p].max(0.0).sqrt();
+        let ratio = external / sigma;
+        if ratio > 1.0 && ratio.is_finite() {
+            ratios[p] = ratio;
+            let scale = if p == 5 { 1.0 } else { 1e3 };
+            let unit = if p == 5 { "rad" } else { "mm" };
+            let values: Vec<String> = own
+                .iter()
+                .map(|(v, var)| format!("{:.4} ± {:.4}", v * scale, var.sqrt() * scale))
+                .collect();
+            said.push(format!(
+                "{} ±{:.4} → ±{:.4} {unit} (×{ratio:.1}; the logs' own {}: χ² {chi2:.1} for \
+                 {} degree(s) of freedom around the joint {:.4})",
+                PARAMETER_NAMES[p],
+                sigma * scale,
+                external * scale,
+                values.join(", "),
+                own.len() - 1,
+                joint_values[p] * scale
+            ));
+        }
+    }
+    if said.is_empty() {
+        return None;
+    }
+    odocal_solver::inflate_sigma_per_parameter(joint, ratios);
+    Some(format!(
+        "the logs disagree beyond their σ, so the joint σ are widened to the logs' spread \
+         (the external error of their weighted mean): {}; the joint σ would otherwise claim \
+         a precision that no log shows",
+        said.join("; ")
+    ))
 }
 
 #[cfg(test)]

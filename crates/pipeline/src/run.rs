@@ -461,14 +461,7 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         .filter(|s| s.icp.fixes_every_direction())
         .count();
     if usable < MIN_SAMPLES {
-        return Err(PipelineError::TooFewSamples {
-            usable,
-            pairs: synced.pairs,
-            needed: MIN_SAMPLES,
-            discarded: synced.discarded.clone(),
-            match_rejections: synced.match_rejections.clone(),
-            scan_returns: synced.scan_returns,
-        });
+        return Err(synced.too_few_samples(usable));
     }
     let samples: Vec<_> = synced
         .samples

@@ -54,6 +54,19 @@ pub struct Synchronized {
 }
 
 impl Synchronized {
+    /// The refusal for `usable` samples, fewer than [`crate::options::MIN_SAMPLES`],
+    /// with these pairs' discards, match rejections and scan returns as its evidence.
+    pub(crate) fn too_few_samples(&self, usable: usize) -> crate::PipelineError {
+        crate::PipelineError::TooFewSamples {
+            usable,
+            pairs: self.pairs,
+            needed: crate::options::MIN_SAMPLES,
+            discarded: self.discarded.clone(),
+            match_rejections: self.match_rejections.clone(),
+            scan_returns: self.scan_returns,
+        }
+    }
+
     /// What keeps every verdict from "well determined" (unrepaired timing, a heading
     /// not from the wheels, a slide not modelled), in words; `None` when nothing does.
     pub fn unjudgeable(&self) -> Option<String> {

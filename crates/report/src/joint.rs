@@ -276,10 +276,13 @@ pub fn build_joint_report(
         c.unknown_messages += log.stats.unknown.values().sum::<u64>();
     }
     let files = Files::new(paths, names, topics);
+    // A log given in phases is compared as a whole: its phases get no finding.
+    let in_phases = |i: usize| joint.phase_groups.iter().any(|g| g.logs.contains(&i));
     report.checks = joint
         .contributions
         .iter()
         .enumerate()
+        .filter(|(i, _)| !in_phases(*i))
         .map(|(i, c)| agreement_finding(&c.agreement, i, names, &files, joint))
         .collect();
     report.logs = joint
@@ -309,7 +312,71 @@ pub fn build_joint_report(
             }
         })
         .collect();
+    report.logs_given = phase_group_rows(joint);
     report
+        .checks
+        .extend(joint.phase_groups.iter().map(phase_group_finding));
+    report
+}
+
+/// With the phases of several logs: one row per log given, its phases together (its
+/// clock offset: its first phase's).
+fn phase_group_rows(joint: &JointOutcome) -> Vec<LogRow> {
+    let own: Vec<&odocal_solver::Calibration> =
+        joint.phase_groups.iter().map(|g| &g.calibration).collect();
+    let shares = odocal_pipeline::log_agreement::information_shares(&own);
+    joint
+        .phase_groups
+        .iter()
+        .zip(shares)
+        .map(|(g, information_share)| {
+            let members = || g.logs.iter().filter_map(|&i| joint.contributions.get(i));
+            let checked = match &g.agreement {
+                Consistency::Checked(h) => Some(h),
+                Consistency::NotAvailable { .. } => None,
+            };
+            let c = &g.calibration;
+            LogRow {
+                path: g.name.clone(),
+                sha256: None,
+                time_offset_s: g
+                    .logs
+                    .first()
+                    .and_then(|&i| joint.logs.get(i))
+                    .map_or(f64::NAN, |o| o.synced.time_offset),
+                samples: members().map(|m| m.samples).sum(),
+                samples_used: c.samples_used,
+                information_share,
+                own: FlatParams::from_array(c.params.to_vector()),
+                own_sigma: std::array::from_fn(|i| c.covariance[i][i].max(0.0).sqrt()),
+                chi2: checked.map(|h| h.chi2),
+                dof: checked.map(|h| h.dof),
+                agree: checked.map(|h| h.agree),
+                disagreeing: checked.map(|h| h.disagreeing.clone()).unwrap_or_default(),
+            }
+        })
+        .collect()
+}
+
+/// A log given, its phases together, against the joint estimate as a finding: a
+/// warning, with what to do, when it disagrees.
+fn phase_group_finding(group: &odocal_pipeline::PhaseGroupCheck) -> Finding {
+    match &group.agreement {
+        Consistency::Checked(h) if h.agree => {
+            Finding::note(FindingKind::LogAgreement, h.sentence.clone())
+        }
+        Consistency::Checked(h) => Finding::warning(
+            FindingKind::LogAgreement,
+            format!(
+                "{}; if it was recorded on another floor or on another robot, calibrate \
+                 without it, or on its own (`odocal calibrate {} --all-pairs`)",
+                h.sentence, group.name
+            ),
+        ),
+        Consistency::NotAvailable { reason } => {
+            Finding::note(FindingKind::LogAgreement, reason.clone())
+        }
+    }
 }
 
 /// One log's agreement as a finding: a warning, with what to do, when it disagrees:
@@ -410,12 +477,13 @@ impl Files {
     }
 }
 
-/// The per-log table of the human summary.
-pub(crate) fn write_log_table(f: &mut fmt::Formatter<'_>, rows: &[LogRow]) -> fmt::Result {
-    writeln!(
-        f,
-        "  per log (own estimate; share of the information on b and ℓθ):"
-    )?;
+/// A per-log table of the human summary, under `heading`.
+pub(crate) fn write_log_table(
+    f: &mut fmt::Formatter<'_>,
+    heading: &str,
+    rows: &[LogRow],
+) -> fmt::Result {
+    writeln!(f, "  {heading}")?;
     for r in rows {
         let agreement = match (r.agree, r.chi2, r.dof) {
             (Some(true), Some(c), Some(n)) => format!("agrees (χ² {c:.1}, {n} dof)"),

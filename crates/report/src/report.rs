@@ -129,6 +129,10 @@ pub struct Report {
     /// With several logs calibrated together: one row per log.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub logs: Vec<crate::joint::LogRow>,
+    /// With `--all-pairs` and several logs given: one row per log given, its phases
+    /// solved together (the rows of `logs` are its phases).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub logs_given: Vec<crate::joint::LogRow>,
     /// With several lasers on the robot: one row per laser (the six-parameter fields
     /// above are the first laser's).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -317,6 +321,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         },
         timing_s: e.timing_s,
         logs: Vec::new(),
+        logs_given: Vec::new(),
         lasers: Vec::new(),
     }
 }
@@ -563,7 +568,18 @@ impl fmt::Display for Report {
             )?;
         }
         if !self.logs.is_empty() {
-            crate::joint::write_log_table(f, &self.logs)?;
+            crate::joint::write_log_table(
+                f,
+                "per log (own estimate; share of the information on b and ℓθ):",
+                &self.logs,
+            )?;
+        }
+        if !self.logs_given.is_empty() {
+            crate::joint::write_log_table(
+                f,
+                "per log given, its phases together (share of the information on b and ℓθ):",
+                &self.logs_given,
+            )?;
         }
         if !self.lasers.is_empty() {
             crate::joint::write_laser_table(f, &self.lasers)?;

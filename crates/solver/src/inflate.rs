@@ -8,18 +8,27 @@ use crate::calibrate::Calibration;
 /// judges the parameters again; a `factor` that is not finite or below 1 changes
 /// nothing (the covariance is only ever made more conservative here).
 pub fn inflate_sigma(calibration: &mut Calibration, factor: f64) {
-    if !(factor.is_finite() && factor > 1.0) {
+    inflate_sigma_per_parameter(calibration, [factor; 6]);
+}
+
+/// Multiplies the σ of parameter `i` (r_L, r_R, b, ℓx, ℓy, ℓθ) of `calibration` by
+/// `factors[i]` (row and column `i` of the covariance: correlations kept) and judges
+/// the parameters again; factors that are not finite or below 1 count as 1. The
+/// slide's σ follow the largest factor.
+pub fn inflate_sigma_per_parameter(calibration: &mut Calibration, factors: [f64; 6]) {
+    let factors = factors.map(|f| if f.is_finite() && f > 1.0 { f } else { 1.0 });
+    if factors.iter().all(|&f| f == 1.0) {
         return;
     }
-    let f2 = factor * factor;
-    for row in calibration.covariance.iter_mut() {
-        for v in row.iter_mut() {
-            *v *= f2;
+    for (i, row) in calibration.covariance.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v *= factors[i] * factors[j];
         }
     }
+    let factor = factors.iter().copied().fold(1.0, f64::max);
     if let Some(slip) = calibration.lateral_slip.as_mut() {
         slip.sigma *= factor;
-        slip.covariance_with_params = slip.covariance_with_params.map(|c| c * f2);
+        slip.covariance_with_params = slip.covariance_with_params.map(|c| c * factor * factor);
     }
     calibration
         .observability
