@@ -137,6 +137,11 @@ fn the_real_logs_given_in_phases_are_compared_and_their_spread_kept() {
     assert_eq!(given.len(), 2);
     let b = v["b"].as_f64().unwrap();
     let sigma_b = v["sigma"][2].as_f64().unwrap();
+    let sums: Vec<&str> = given.iter().filter_map(|r| r["sha256"].as_str()).collect();
+    assert!(
+        sums.len() == 2 && sums[0] != sums[1] && sums[0].len() == 64,
+        "{sums:?}"
+    );
     for row in given {
         assert!(row["agree"].is_boolean(), "{row}");
         // Measured (stop 44): the logs' b, 297.5 ± 1.4 and 308.7 ± 1.9 mm, differ by

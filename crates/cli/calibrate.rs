@@ -487,6 +487,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             row.sha256 = Some(sha256.clone());
             *checksum = Some((sha256, bytes));
         }
+        // A log given in phases: its file's checksum, as its phases have.
+        for (row, group) in report.logs_given.iter_mut().zip(&groups) {
+            row.sha256 = group
+                .logs
+                .first()
+                .and_then(|&i| checksums.get(i))
+                .and_then(|c| c.as_ref().map(|(sha256, _)| sha256.clone()));
+        }
         (joint.joint, report)
     };
     outcome.timing.parse = parse_s;
