@@ -462,13 +462,25 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         (outcome, report)
     } else {
         let named: Vec<(&str, &Log)> = names.iter().map(String::as_str).zip(&logs).collect();
-        let joint = pool.install(|| {
-            if groups.is_empty() {
-                calibrate_logs_with_lasers(&named, &setup, &opts, &bar)
-            } else {
-                odocal_pipeline::calibrate_log_phases(&named, &groups, &opts, &bar)
-            }
-        })?;
+        let joint = pool
+            .install(|| {
+                if groups.is_empty() {
+                    calibrate_logs_with_lasers(&named, &setup, &opts, &bar)
+                } else {
+                    odocal_pipeline::calibrate_log_phases(&named, &groups, &opts, &bar)
+                }
+            })
+            .map_err(|e| match e {
+                // One laser's joint estimate refused for parameters it leaves weak: the
+                // exact command that holds them, as for one log (several lasers' holds
+                // name the first laser's parameters only: left as the refusal says).
+                odocal_pipeline::JointError::Joint(refusal)
+                    if lasers == 1 && !refusal.holds().is_empty() =>
+                {
+                    refused(refusal).context("the joint calibration of the logs")
+                }
+                e => e.into(),
+            })?;
         let all: Vec<&Log> = logs.iter().collect();
         let mut report = build_joint_report(&paths, &names, &topics, &all, &opts, &joint);
         for (row, n) in report
