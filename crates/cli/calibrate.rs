@@ -470,16 +470,26 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                     odocal_pipeline::calibrate_log_phases(&named, &groups, &opts, &bar)
                 }
             })
-            .map_err(|e| match e {
-                // One laser's joint estimate refused for parameters it leaves weak: the
-                // exact command that holds them, as for one log (several lasers' holds
-                // name the first laser's parameters only: left as the refusal says).
-                odocal_pipeline::JointError::Joint(refusal)
-                    if lasers == 1 && !refusal.holds().is_empty() =>
-                {
-                    refused(refusal).context("the joint calibration of the logs")
+            .map_err(|e| {
+                let what = match &groups[..] {
+                    [one] => format!("every scan pair of {} (its phases together)", one.name),
+                    _ => "the joint calibration of the logs".to_string(),
+                };
+                match e {
+                    // One laser's joint estimate refused for parameters it leaves weak:
+                    // the exact command that holds them, as for one log (several
+                    // lasers' holds name the first laser's parameters only: left as the
+                    // refusal says).
+                    odocal_pipeline::JointError::Joint(refusal)
+                        if lasers == 1 && !refusal.holds().is_empty() =>
+                    {
+                        refused(refusal).context(what)
+                    }
+                    odocal_pipeline::JointError::Joint(refusal) => {
+                        anyhow::Error::from(refusal).context(what)
+                    }
+                    e => e.into(),
                 }
-                e => e.into(),
             })?;
         let all: Vec<&Log> = logs.iter().collect();
         let mut report = build_joint_report(&paths, &names, &topics, &all, &opts, &joint);
