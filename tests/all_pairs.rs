@@ -97,18 +97,38 @@ fn the_real_forward_only_logs_are_offered_every_pair_and_gain_from_it() {
                 .is_some_and(|c| c.contains("--fix")),
             "{v}"
         );
-        // Measured (stop 43): the pose σ 2.3–3.0× smaller with every pair.
+        // Measured (stop 44): the real logs' phases share their errors where their
+        // pairs overlap (residuals correlated by 0.46–0.83 at full overlap: the
+        // wheels' slips and scrubs), so every pair narrows the pose σ by less than the
+        // four phases would if independent (stop 43's 2.3–3× was that claim); the σ
+        // are scaled, and the finding says by how much.
         let one = calibrate_json(&[log, "--accept-weak"]);
         let all = calibrate_json(&[log, "--accept-weak", "--all-pairs"]);
         let (s1, sa) = (pose_sigma(&one), pose_sigma(&all));
         for i in 0..3 {
             assert!(
-                sa[i] < s1[i] / 1.5,
+                sa[i] < s1[i] && sa[i] > s1[i] / 2.0,
                 "{name} pose σ {i}: {} → {}",
                 s1[i],
                 sa[i]
             );
         }
+        let shared = all["health"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|f| f["kind"] == "phase_correlation")
+            .unwrap_or_else(|| panic!("{name}: no phase_correlation finding"));
+        // Measured: σ ×1.77 (exp1), the residuals correlated by 0.5–0.8.
+        let factor: f64 = shared["message"]
+            .as_str()
+            .unwrap()
+            .rsplit("σ ×")
+            .next()
+            .and_then(|t| t.get(..4))
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("{shared}"));
+        assert!(factor > 1.3, "{name}: σ ×{factor}");
     }
 }
 
@@ -185,16 +205,30 @@ fn a_refusal_of_every_pair_gives_the_command_that_holds_what_is_weak() {
     let err = stderr(&o);
     assert!(!o.status.success(), "{err}");
     let command = command_after(&err, "to calibrate the other parameters, run");
-    assert!(command.ends_with("--all-pairs --fix l_y=0"), "{command}");
-    // The command as given calibrates, within 3σ of the truth.
-    let args: Vec<&str> = command.split(' ').skip(1).collect();
-    let mut with_json = args.clone();
-    with_json.push("--json");
-    let o = odocal(&with_json);
+    assert!(command.contains("--all-pairs --fix "), "{command}");
+    // The command as given calibrates, a value to measure measured (the truth), every
+    // free parameter within 3σ of the truth.
+    let names = ["r_l", "r_r", "b", "l_x", "l_y", "l_theta"];
+    let measured: Vec<String> = command
+        .split(' ')
+        .skip(1)
+        .map(|w| match w.split_once("=MEASURED") {
+            Some((name, _)) => {
+                let i = names.iter().position(|n| *n == name).expect("a parameter");
+                format!("{name}={}", truth[i])
+            }
+            None => w.to_string(),
+        })
+        .collect();
+    let mut args: Vec<&str> = measured.iter().map(String::as_str).collect();
+    args.push("--json");
+    let o = odocal(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("JSON");
-    let names = ["r_l", "r_r", "b", "l_x", "l_y", "l_theta"];
-    for (i, name) in names.iter().enumerate().filter(|(i, _)| *i != 4) {
+    for (i, name) in names.iter().enumerate() {
+        if command.contains(&format!("--fix {name}=")) {
+            continue;
+        }
         let sigma = v["range_scale"]["sigma_total"][i].as_f64().unwrap();
         let e = (v[name].as_f64().unwrap() - truth[i]) / sigma;
         assert!(e.abs() < 3.0, "{name}: {e:+.2}σ");

@@ -38,6 +38,8 @@ pub enum FindingKind {
     ReadJitter,
     /// One log of a joint calibration against the joint estimate.
     LogAgreement,
+    /// The phases of one log (`--all-pairs`) sharing part of their errors.
+    PhaseCorrelation,
     /// Odometry-only mode on odometry whose heading is not integrated from the wheels
     /// (a gyro's or a filter's).
     GyroHeading,
@@ -82,6 +84,7 @@ impl FindingKind {
             FindingKind::TwoHalves => "two_halves",
             FindingKind::ReadJitter => "read_jitter",
             FindingKind::LogAgreement => "log_agreement",
+            FindingKind::PhaseCorrelation => "phase_correlation",
             FindingKind::GyroHeading => "gyro_heading",
             FindingKind::LateralSlip => "lateral_slip",
         }

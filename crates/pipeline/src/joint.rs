@@ -12,6 +12,7 @@ use crate::finding::{Finding, FindingKind};
 use crate::lasers::{comparison_options, solve, LaserSetup, Solved};
 use crate::log_agreement::{check_log, information_shares};
 use crate::options::{Options, MIN_SAMPLES};
+use crate::phase_correlation::PhaseCorrelation;
 use crate::progress::Progress;
 use crate::rejection::RejectionCounts;
 use crate::run::{calibrate_log, refuse_poorly_determined, Outcome, Timing};
@@ -62,6 +63,9 @@ pub struct JointOutcome {
     /// With the phases of several logs ([`calibrate_log_phases`]): per log given, its
     /// phases' estimate together against the joint one; empty otherwise.
     pub phase_groups: Vec<PhaseGroupCheck>,
+    /// Per log given in phases: how much its phases share their errors (the joint σ
+    /// are scaled by the largest factor).
+    pub phase_correlations: Vec<(String, PhaseCorrelation)>,
 }
 
 /// The phases of one log given (`--all-pairs`, [`crate::phases`]): the logs of a
@@ -214,7 +218,7 @@ fn calibrate_joint(
         samples,
         mut synced,
         solve_options,
-        solved,
+        mut solved,
     } = solve_together(&all, &laser_of_log, lasers, opts).map_err(|e| {
         // Too few samples together: each log's own findings were already given.
         JointError::Joint(match e {
@@ -239,6 +243,42 @@ fn calibrate_joint(
              logs on their own (`odocal calibrate LOG --lateral-slip`), or give \
              `--no-lateral-slip` if the robot does not slide"
         ));
+    }
+    // Several logs given in phases: each solved on its own, its phases' shared
+    // errors measured on its own estimate's residuals.
+    let group_estimates: Vec<(Calibration, Option<PhaseCorrelation>)> = if groups.len() > 1 {
+        groups
+            .iter()
+            .map(|g| group_estimate(g, &outcomes, opts))
+            .collect::<Result<_, _>>()?
+    } else {
+        Vec::new()
+    };
+    // One log's phases share their errors where they overlap in time: the joint σ
+    // scaled by the largest log's factor before anything is compared with them.
+    let phase_correlations: Vec<(String, PhaseCorrelation)> = match groups {
+        _ if solved.lasers.is_some() => Vec::new(),
+        [one] => {
+            let members: Vec<&Outcome> = one.logs.iter().filter_map(|&i| outcomes.get(i)).collect();
+            let residuals = slide_residuals(&solved.first, &samples, opts);
+            crate::phase_correlation::measure(&members, &residuals, &solved.first.used)
+                .map(|c| vec![(one.name.clone(), c)])
+                .unwrap_or_default()
+        }
+        _ => groups
+            .iter()
+            .zip(&group_estimates)
+            .filter_map(|(g, (_, c))| c.map(|c| (g.name.clone(), c)))
+            .collect(),
+    };
+    let shared_factor = phase_correlations
+        .iter()
+        .map(|(_, c)| c.sigma_factor)
+        .fold(1.0, f64::max);
+    odocal_solver::inflate_sigma(&mut solved.first, shared_factor);
+    synced.shared_error_factor = shared_factor;
+    if let Some(finding) = crate::phase_correlation::finding(&phase_correlations) {
+        health.push(finding);
     }
     let agreements: Vec<Consistency> = logs
         .iter()
@@ -270,14 +310,22 @@ fn calibrate_joint(
             check_log(&o.calibration, &view, &compared, name, alone)
         })
         .collect();
-    let phase_groups = if groups.len() > 1 {
-        groups
-            .iter()
-            .map(|g| phase_group_check(g, &outcomes, &solved.first, &solve_options, opts))
-            .collect::<Result<Vec<_>, _>>()?
-    } else {
-        Vec::new()
-    };
+    let phase_groups: Vec<PhaseGroupCheck> = groups
+        .iter()
+        .zip(group_estimates)
+        .map(|(g, (mut calibration, shared))| {
+            // Its phases share their errors as they do in the joint solve.
+            odocal_solver::inflate_sigma(&mut calibration, shared.map_or(1.0, |c| c.sigma_factor));
+            let name = format!("{} (its {} phases together)", g.name, g.logs.len());
+            let agreement = check_log(&calibration, &solved.first, &solve_options, &name, false);
+            PhaseGroupCheck {
+                name: g.name.clone(),
+                logs: g.logs.clone(),
+                calibration,
+                agreement,
+            }
+        })
+        .collect();
     let Solved {
         first: mut calibration,
         mut lasers,
@@ -420,6 +468,7 @@ fn calibrate_joint(
         laser_of_log,
         lasers,
         phase_groups,
+        phase_correlations,
     })
 }
 
@@ -483,15 +532,13 @@ fn solve_together(
 
 /// The log `group` given, its phases (`outcomes` at `group.logs`) solved together as
 /// a log is alone (the slide weighed in, σ scaled by the matcher's own error, the
-/// verdicts judged with weak parameters accepted), compared with the joint estimate
-/// `joint` (solved with `solve_options`).
-fn phase_group_check(
+/// verdicts judged with weak parameters accepted), with how much its phases share
+/// their errors, measured on its own residuals (not yet applied to its σ).
+fn group_estimate(
     group: &LogPhases,
     outcomes: &[Outcome],
-    joint: &Calibration,
-    solve_options: &SolveOptions,
     opts: &Options,
-) -> Result<PhaseGroupCheck, JointError> {
+) -> Result<(Calibration, Option<PhaseCorrelation>), JointError> {
     let members: Vec<&Outcome> = group.logs.iter().filter_map(|&i| outcomes.get(i)).collect();
     let own = Options {
         accept_weak: true,
@@ -511,6 +558,8 @@ fn phase_group_check(
     )
     .map_err(failed)?;
     let mut calibration = t.solved.first;
+    let residuals = slide_residuals(&calibration, &t.samples, opts);
+    let shared = crate::phase_correlation::measure(&members, &residuals, &calibration.used);
     if let Some(check) = &t.synced.match_self_check {
         let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
         odocal_solver::inflate_sigma(&mut calibration, factor);
@@ -518,14 +567,17 @@ fn phase_group_check(
     let calibration =
         refuse_poorly_determined(calibration, &t.synced, &t.samples, &t.solve_options, &own)
             .map_err(failed)?;
-    let name = format!("{} (its {} phases together)", group.name, members.len());
-    let agreement = check_log(&calibration, joint, solve_options, &name, false);
-    Ok(PhaseGroupCheck {
-        name: group.name.clone(),
-        logs: group.logs.clone(),
-        calibration,
-        agreement,
-    })
+    Ok((calibration, shared))
+}
+
+/// The residuals of `samples` at `calibration`'s estimate, its sideways slide as
+/// weighed in.
+fn slide_residuals(calibration: &Calibration, samples: &[Sample], opts: &Options) -> Vec<[f64; 3]> {
+    let k = calibration
+        .lateral_slip
+        .as_ref()
+        .map_or(0.0, |s| s.weight * s.k);
+    odocal_solver::residuals_with_slide(&calibration.params, k, samples, opts.use_profile)
 }
 
 /// The command that gives the disagreeing logs (`which`, positions in `names`) their
@@ -646,6 +698,8 @@ fn merged(outcomes: &[&Outcome]) -> Synchronized {
         // Set by the joint solve when its model cannot hold a log's slide.
         unmodelled_slide: None,
         scan_returns: first.scan_returns,
+        // Set by the joint solve when the logs are one log's phases.
+        shared_error_factor: 1.0,
     }
 }
 

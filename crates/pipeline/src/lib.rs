@@ -51,6 +51,7 @@ pub mod matcher_bias;
 pub mod matching;
 pub mod options;
 pub mod parallel;
+pub mod phase_correlation;
 pub mod phases;
 mod progress;
 pub mod range_finder;

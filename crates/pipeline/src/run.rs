@@ -343,6 +343,7 @@ pub fn synchronize_and_match(
         heading_not_from_wheels: None,
         unmodelled_slide: None,
         scan_returns: crate::matching::scan_returns(&log.scans),
+        shared_error_factor: 1.0,
     })
 }
 
@@ -597,6 +598,9 @@ pub(crate) fn refuse_poorly_determined(
                         solve_options,
                         &calibration,
                         opts.initial_params.as_ref(),
+                        opts.lateral_slip,
+                        synced.match_self_check.as_ref(),
+                        synced.shared_error_factor,
                     ),
                 },
                 caveat: None,

@@ -51,6 +51,10 @@ pub struct Synchronized {
     /// per scan and the rays per scan (of the first log, with several), when any
     /// scan was read; a refusal for too few matches names it.
     pub scan_returns: Option<crate::matching::ScanReturns>,
+    /// The factor on the σ for the phases of a log sharing their errors
+    /// ([`crate::phase_correlation`]; 1: none, or one log alone). The parameters to
+    /// hold that a refusal proposes are judged with it.
+    pub shared_error_factor: f64,
 }
 
 impl Synchronized {

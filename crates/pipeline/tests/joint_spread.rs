@@ -157,5 +157,12 @@ fn logs_given_in_phases_are_compared_as_wholes() {
             );
         }
         assert_eq!(widening(&joint).is_some(), !agree);
+        // A Khepera's phases share little of their errors (its matcher's dominate):
+        // measured, and the σ hardly scaled.
+        assert_eq!(joint.phase_correlations.len(), 2);
+        for (name, c) in &joint.phase_correlations {
+            assert!(c.sigma_factor < 1.2, "{name}: {c:?}");
+            assert!(c.rho.iter().all(|r| r.abs() < 0.3), "{name}: {c:?}");
+        }
     }
 }

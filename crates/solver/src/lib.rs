@@ -103,4 +103,5 @@ pub use range_scale::{
 pub use refine::Refinement;
 pub use sample::{ProfileSegment, Sample};
 pub use shared_scans::{SharedScanNoise, MIN_SHARED_SCANS};
+pub use slide_kinematics::residuals_with_slide;
 pub use trimming::Trim;

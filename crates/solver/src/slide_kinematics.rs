@@ -144,6 +144,23 @@ pub(crate) fn predict_with_slide(
     ([s6[0] + k * sw[0], s6[1] + k * sw[1], wrap_fast(s6[2])], g)
 }
 
+/// `ŝ_pred − ŝ` (θ wrapped) for every sample with the sideways slide `k` (0: the
+/// six-parameter model's residuals).
+pub fn residuals_with_slide(
+    params: &Params,
+    k: f64,
+    samples: &[Sample],
+    use_profile: bool,
+) -> Vec<[f64; 3]> {
+    samples
+        .iter()
+        .map(|s| {
+            let (p, _) = predict_with_slide(params, k, s, use_profile);
+            crate::kinematics::residual_of(p, &s.sm.to_array())
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
