@@ -44,6 +44,16 @@ pub struct LogRow {
     pub disagreeing: Vec<String>,
 }
 
+/// One log given in phases (`--all-pairs`): how much its phases share their errors.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PhaseCorrelationRow {
+    /// The log as given.
+    pub log: String,
+    /// The correlation and the factor on the σ.
+    #[serde(flatten)]
+    pub correlation: odocal_pipeline::phase_correlation::PhaseCorrelation,
+}
+
 /// One laser of a robot with several: its pose with the shared wheels, and its pose
 /// in the first laser's frame.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -313,6 +323,14 @@ pub fn build_joint_report(
         })
         .collect();
     report.logs_given = phase_group_rows(joint);
+    report.phase_correlation = joint
+        .phase_correlations
+        .iter()
+        .map(|(log, correlation)| PhaseCorrelationRow {
+            log: log.clone(),
+            correlation: *correlation,
+        })
+        .collect();
     report
         .checks
         .extend(joint.phase_groups.iter().map(phase_group_finding));

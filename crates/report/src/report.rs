@@ -133,6 +133,10 @@ pub struct Report {
     /// solved together (the rows of `logs` are its phases).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub logs_given: Vec<crate::joint::LogRow>,
+    /// With `--all-pairs`: per log given, how much its phases share their errors
+    /// (the joint σ are scaled by the largest `sigma_factor`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub phase_correlation: Vec<crate::joint::PhaseCorrelationRow>,
     /// With several lasers on the robot: one row per laser (the six-parameter fields
     /// above are the first laser's).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -322,6 +326,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         timing_s: e.timing_s,
         logs: Vec::new(),
         logs_given: Vec::new(),
+        phase_correlation: Vec::new(),
         lasers: Vec::new(),
     }
 }
