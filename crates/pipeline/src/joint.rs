@@ -258,8 +258,9 @@ fn calibrate_joint(
     // scaled by the largest log's factor before anything is compared with them.
     let phase_correlations: Vec<(String, PhaseCorrelation)> = match groups {
         _ if solved.lasers.is_some() => Vec::new(),
-        [one] => {
-            let members: Vec<&Outcome> = one.logs.iter().filter_map(|&i| outcomes.get(i)).collect();
+        // One log given, every log its phase (in order): the joint estimate is its own.
+        [one] if one.logs.iter().copied().eq(0..outcomes.len()) => {
+            let members: Vec<&Outcome> = outcomes.iter().collect();
             let residuals = slide_residuals(&solved.first, &samples, opts);
             crate::phase_correlation::measure(&members, &residuals, &solved.first.used)
                 .map(|c| vec![(one.name.clone(), c)])
