@@ -396,7 +396,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     opts.solve.trim = args.trim.into();
     opts.solve.refine = !args.no_refine;
     opts.solve.constraints = constraints.shared;
-    let mut setup = LaserSetup {
+    let setup = LaserSetup {
         of_log: laser_of_log.clone(),
         nominal: other_nominal
             .iter()
@@ -441,8 +441,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                  logs on their own"
             );
         }
+        // Its phases are one laser's logs (`calibrate_log_phases`): `setup` is not used.
         inputs = inputs.into_phases(&opts)?;
-        setup.of_log = vec![0; inputs.logs.len()];
     }
     let LogInputs {
         logs,

@@ -111,38 +111,22 @@ fn undetermined_half(
     b: &Calibration,
     options: &SolveOptions,
 ) -> Result<Vec<usize>, String> {
-    let free: Vec<usize> = (0..6)
-        .filter(|&i| !options.constraints.is_held(i))
-        .collect();
     let mut weak: Vec<usize> = Vec::new();
     for (half, name) in [(a, "first"), (b, "second")] {
-        let verdict = |i: usize| half.observability.parameters[i].verdict;
-        let not_well: Vec<usize> = free
-            .iter()
-            .copied()
-            .filter(|&i| verdict(i) != Verdict::WellDetermined)
-            .collect();
-        if not_well.len() == free.len()
-            || not_well.iter().any(|&i| verdict(i) == Verdict::NotExcited)
-        {
-            let names: Vec<&str> = not_well
-                .iter()
-                .map(|&i| half.observability.parameters[i].name.as_str())
-                .collect();
-            return Err(format!(
-                "the {name} half alone does not determine {} well ({} samples): the log \
-                 is too short, or its motion too uneven, for the two-halves check",
-                names.join(", "),
-                half.samples_used
-            ));
-        }
-        for i in not_well {
-            if !weak.contains(&i) {
-                weak.push(i);
+        match left_out(half, options) {
+            Ok(not_well) => weak.extend(not_well),
+            Err(not_well) => {
+                return Err(format!(
+                    "the {name} half alone does not determine {} well ({} samples): the log \
+                     is too short, or its motion too uneven, for the two-halves check",
+                    names_of(half, &not_well),
+                    half.samples_used
+                ))
             }
         }
     }
     weak.sort_unstable();
+    weak.dedup();
     let sign = |c: &Calibration| (c.params.r_l.signum(), c.params.r_r.signum());
     if sign(a) != sign(b) {
         return Err(
@@ -153,6 +137,36 @@ fn undetermined_half(
         );
     }
     Ok(weak)
+}
+
+/// The free parameters (not held in `options`) that `c` does not determine well:
+/// `Ok` when they are only weak and some free parameter is well determined (a
+/// comparison leaves them out, [`leaving_out`]); `Err` when one is not excited at all
+/// or none is well determined (no comparison is valid).
+pub(crate) fn left_out(c: &Calibration, options: &SolveOptions) -> Result<Vec<usize>, Vec<usize>> {
+    let verdict = |i: usize| c.observability.parameters[i].verdict;
+    let free: Vec<usize> = (0..6)
+        .filter(|&i| !options.constraints.is_held(i))
+        .collect();
+    let not_well: Vec<usize> = free
+        .iter()
+        .copied()
+        .filter(|&i| verdict(i) != Verdict::WellDetermined)
+        .collect();
+    if not_well.len() == free.len() || not_well.iter().any(|&i| verdict(i) == Verdict::NotExcited) {
+        Err(not_well)
+    } else {
+        Ok(not_well)
+    }
+}
+
+/// The names of parameters `which` as `c`'s observability gives them, joined.
+pub(crate) fn names_of(c: &Calibration, which: &[usize]) -> String {
+    which
+        .iter()
+        .map(|&i| c.observability.parameters[i].name.as_str())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// `options` with the parameters `left_out` counting as held (at `at`'s values), so

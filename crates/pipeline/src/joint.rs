@@ -244,9 +244,13 @@ fn calibrate_joint(
              `--no-lateral-slip` if the robot does not slide"
         ));
     }
+    // Several logs given in phases: each log given is compared whole. One log given
+    // in phases (every log its phase, in order): the joint estimate is its own.
+    let logs_given_in_phases = groups.len() > 1;
+    let one_log_in_phases = matches!(groups, [one] if one.logs.iter().copied().eq(0..logs.len()));
     // Several logs given in phases: each solved on its own, its phases' shared
     // errors measured on its own estimate's residuals.
-    let group_estimates: Vec<(Calibration, Option<PhaseCorrelation>)> = if groups.len() > 1 {
+    let group_estimates: Vec<(Calibration, Option<PhaseCorrelation>)> = if logs_given_in_phases {
         groups
             .iter()
             .map(|g| group_estimate(g, &outcomes, opts))
@@ -258,8 +262,7 @@ fn calibrate_joint(
     // scaled by the largest log's factor before anything is compared with them.
     let phase_correlations: Vec<(String, PhaseCorrelation)> = match groups {
         _ if solved.lasers.is_some() => Vec::new(),
-        // One log given, every log its phase (in order): the joint estimate is its own.
-        [one] if one.logs.iter().copied().eq(0..outcomes.len()) => {
+        [one] if one_log_in_phases => {
             let members: Vec<&Outcome> = outcomes.iter().collect();
             let residuals = slide_residuals(&solved.first, &samples, opts);
             crate::phase_correlation::measure(&members, &residuals, &solved.first.used)
@@ -293,7 +296,7 @@ fn calibrate_joint(
             if let Some(g) = groups
                 .iter()
                 .find(|g| g.logs.contains(&index))
-                .filter(|_| groups.len() > 1)
+                .filter(|_| logs_given_in_phases)
             {
                 return Consistency::NotAvailable {
                     reason: format!(
@@ -331,18 +334,18 @@ fn calibrate_joint(
         first: mut calibration,
         mut lasers,
     } = solved;
-    if let Some(check) = &synced.match_self_check {
-        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
-        odocal_solver::inflate_sigma(&mut calibration, factor);
-        if let Some(l) = lasers
-            .as_mut()
-            .filter(|_| factor.is_finite() && factor > 1.0)
-        {
-            l.covariance
-                .iter_mut()
-                .flatten()
-                .for_each(|v| *v *= factor * factor);
-        }
+    let factor = crate::match_quality::scale_by_self_check(
+        &mut calibration,
+        synced.match_self_check.as_ref(),
+    );
+    if let Some(l) = lasers
+        .as_mut()
+        .filter(|_| factor.is_finite() && factor > 1.0)
+    {
+        l.covariance
+            .iter_mut()
+            .flatten()
+            .for_each(|v| *v *= factor * factor);
     }
     if lasers.is_none() {
         // Logs that disagree widen the joint σ to their spread: the logs given when
@@ -428,16 +431,15 @@ fn calibrate_joint(
         })
         .collect();
     let consistency = Consistency::NotAvailable {
-        reason: match groups {
-            // Measured (stop 44): the halves of one log in phases, at every pair's σ,
-            // differ on 13 of 30 simulated TurtleBot 4 logs, by the range bias that
-            // drifts with time, which the σ with the range scale already cover.
-            [one] if one.logs.len() == outcomes.len() => "one log in phases: each phase's \
-                own estimate is compared with the joint one instead"
-                .into(),
-            _ => "several logs: each log's own estimate is compared with the joint one \
-                  instead"
-                .into(),
+        // Measured (stop 44): the halves of one log in phases, at every pair's σ,
+        // differ on 13 of 30 simulated TurtleBot 4 logs, by the range bias that drifts
+        // with time, which the σ with the range scale already cover.
+        reason: if one_log_in_phases {
+            "one log in phases: each phase's own estimate is compared with the joint one \
+             instead"
+                .into()
+        } else {
+            "several logs: each log's own estimate is compared with the joint one instead".into()
         },
     };
     let mut timing = outcomes.iter().fold(Timing::default(), |a, o| Timing {
@@ -561,10 +563,7 @@ fn group_estimate(
     let mut calibration = t.solved.first;
     let residuals = slide_residuals(&calibration, &t.samples, opts);
     let shared = crate::phase_correlation::measure(&members, &residuals, &calibration.used);
-    if let Some(check) = &t.synced.match_self_check {
-        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
-        odocal_solver::inflate_sigma(&mut calibration, factor);
-    }
+    crate::match_quality::scale_by_self_check(&mut calibration, t.synced.match_self_check.as_ref());
     let calibration =
         refuse_poorly_determined(calibration, &t.synced, &t.samples, &t.solve_options, &own)
             .map_err(failed)?;

@@ -4,7 +4,9 @@
 //! two-halves check's rules ([`crate::consistency`]); and the share of the
 //! information on each parameter that each log brings.
 
-use crate::consistency::{compare, leaving_out, Consistency, HalvesCheck, Z_LIMIT};
+use crate::consistency::{
+    compare, leaving_out, left_out, names_of, Consistency, HalvesCheck, Z_LIMIT,
+};
 use nalgebra::DMatrix;
 use odocal_solver::{Calibration, SolveOptions, Verdict, PARAMETER_NAMES};
 
@@ -28,42 +30,20 @@ pub fn check_log(
     name: &str,
     own_covariance: bool,
 ) -> Consistency {
-    let free: Vec<usize> = (0..6)
-        .filter(|&i| !options.constraints.is_held(i))
-        .collect();
-    let verdict = |i: usize| log.observability.parameters[i].verdict;
-    let names_of = |which: &[usize]| -> String {
-        which
-            .iter()
-            .map(|&i| log.observability.parameters[i].name.as_str())
-            .collect::<Vec<_>>()
-            .join(", ")
+    let weak = match left_out(log, options) {
+        Ok(weak) => weak,
+        Err(missing) => {
+            return Consistency::NotAvailable {
+                reason: format!(
+                    "{name} alone does not determine {} well ({} samples), so its own \
+                     estimate is not compared with the joint one; its samples count only in \
+                     the joint fit",
+                    names_of(log, &missing),
+                    log.samples_used
+                ),
+            }
+        }
     };
-    let unexcited: Vec<usize> = free
-        .iter()
-        .copied()
-        .filter(|&i| verdict(i) == Verdict::NotExcited)
-        .collect();
-    let weak: Vec<usize> = free
-        .iter()
-        .copied()
-        .filter(|&i| verdict(i) == Verdict::Weak)
-        .collect();
-    if !unexcited.is_empty() || weak.len() == free.len() {
-        let missing: Vec<usize> = free
-            .iter()
-            .copied()
-            .filter(|&i| verdict(i) != Verdict::WellDetermined)
-            .collect();
-        return Consistency::NotAvailable {
-            reason: format!(
-                "{name} alone does not determine {} well ({} samples), so its own estimate \
-                 is not compared with the joint one; its samples count only in the joint fit",
-                names_of(&missing),
-                log.samples_used
-            ),
-        };
-    }
     let sign = |c: &Calibration| (c.params.r_l.signum(), c.params.r_r.signum());
     if sign(log) != sign(joint) {
         return Consistency::NotAvailable {
@@ -81,7 +61,7 @@ pub fn check_log(
         format!(
             "{name} and the joint estimate, on the parameters the log alone determines \
              well (not {}: weak in it),",
-            names_of(&weak)
+            names_of(log, &weak)
         )
     };
     let covariance = if own_covariance {

@@ -63,6 +63,19 @@ pub fn sigma_inflation(check: &MatchSelfCheck, sm_sigma: [f64; 3]) -> f64 {
     }
 }
 
+/// Scales `calibration`'s σ by the matcher's own error (`check`, when the log had
+/// enough scan triples): [`sigma_inflation`] against its scan-matching noise. Returns
+/// the factor (1 without a check or below the tolerance).
+pub(crate) fn scale_by_self_check(
+    calibration: &mut odocal_solver::Calibration,
+    check: Option<&MatchSelfCheck>,
+) -> f64 {
+    let Some(check) = check else { return 1.0 };
+    let factor = sigma_inflation(check, calibration.sm_sigma);
+    odocal_solver::inflate_sigma(calibration, factor);
+    factor
+}
+
 /// The motion per pair the parameters are determined from: RMS over the samples.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MotionPerPair {

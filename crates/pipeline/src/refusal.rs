@@ -134,18 +134,17 @@ fn all_determined(c: &Calibration) -> bool {
 /// by holding them at the values proposed — from `--nominal`, the usual mounting (ℓy
 /// and ℓθ at 0) — or, for a value left to measure, at the refused estimate (a held
 /// value moves the others' σ: on the real exp2 log, ℓy held at its estimate left ℓx
-/// well determined, held at the proposed 0 it did not). `shared_error_factor` scales
-/// the σ as the phases' shared errors scaled the refused estimate's (1 for one log);
-/// `slide` is the run's sideways-slide model, weighed in as the run does, and
-/// `self_check` the matcher's own error, which scales the σ as in the run.
+/// well determined, held at the proposed 0 it did not). Each trial is judged as the
+/// run proposed will be: `slide`, the run's sideways-slide model, weighed in, and the
+/// σ scaled by `synced`'s self-check (the matcher's own error) and its phases' shared
+/// errors.
 pub fn holds(
     samples: &[Sample],
     options: &SolveOptions,
     refused: &Calibration,
     nominal: Option<&Params>,
     slide: crate::lateral_slip::SlideModel,
-    self_check: Option<&crate::self_check::MatchSelfCheck>,
-    shared_error_factor: f64,
+    synced: &crate::synchronized::Synchronized,
 ) -> Vec<Hold> {
     let estimate = refused.params.to_vector();
     let free: Vec<usize> = HOLD_ORDER
@@ -177,15 +176,15 @@ pub fn holds(
             // the σ is often ℓx's largest on a skid-steer robot).
             crate::lateral_slip::check_and_apply(&mut c, samples, &o, slide);
             // The matcher's own error scales the σ as it does the run's.
-            if let Some(check) = self_check {
-                let factor = crate::match_quality::sigma_inflation(check, c.sm_sigma);
-                odocal_solver::inflate_sigma(&mut c, factor);
-            }
+            crate::match_quality::scale_by_self_check(&mut c, synced.match_self_check.as_ref());
             // With a margin: the command proposed is run on data matched anew with
             // the held values, and must not land just past a threshold.
             // The phases' shared errors scale the σ of the run proposed as they did
             // this one's.
-            odocal_solver::inflate_sigma(&mut c, HOLD_SIGMA_MARGIN * shared_error_factor.max(1.0));
+            odocal_solver::inflate_sigma(
+                &mut c,
+                HOLD_SIGMA_MARGIN * synced.shared_error_factor.max(1.0),
+            );
             all_determined(&c)
         })
     };

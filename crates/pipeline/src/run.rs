@@ -480,11 +480,8 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         &solve_options,
         opts.lateral_slip,
     );
-    if let Some(check) = &synced.match_self_check {
-        // The matcher's own error, when larger than the residuals' noise, scales σ.
-        let factor = crate::match_quality::sigma_inflation(check, calibration.sm_sigma);
-        odocal_solver::inflate_sigma(&mut calibration, factor);
-    }
+    // The matcher's own error, when larger than the residuals' noise, scales σ.
+    crate::match_quality::scale_by_self_check(&mut calibration, synced.match_self_check.as_ref());
     refuse_poorly_determined(calibration, synced, &samples, &solve_options, opts)
 }
 
@@ -599,8 +596,7 @@ pub(crate) fn refuse_poorly_determined(
                         &calibration,
                         opts.initial_params.as_ref(),
                         opts.lateral_slip,
-                        synced.match_self_check.as_ref(),
-                        synced.shared_error_factor,
+                        synced,
                     ),
                 },
                 caveat: None,
