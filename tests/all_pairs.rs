@@ -58,6 +58,38 @@ fn every_pair_shrinks_the_pose_sigma_and_keeps_the_truth_within_it() {
 }
 
 #[test]
+fn the_phases_of_one_log_are_judged_by_the_joint_sigma_for_their_share() {
+    // Measured (stop 45): on this log the phases' own σ of b differ by 1.6× (each
+    // phase's noise estimate is a noisy draw), and judged by them the second phase
+    // disagreed with its own log's joint estimate (χ² 49.9 for 6; r_L, r_R, b beyond
+    // 3σ); judged by the joint σ for its share of the samples it agrees (χ² 4.9).
+    let (path, _) = simulated_log("all-pairs-alike", "turtlebot4-rplidar", 120.0, 108, |_| {});
+    let v = calibrate_json(&[path.to_str().unwrap(), "--accept-weak", "--all-pairs"]);
+    let rows = v["logs"].as_array().expect("a row per phase");
+    assert!(rows.len() >= 2, "{rows:?}");
+    let own_b: Vec<f64> = rows
+        .iter()
+        .map(|r| r["own_sigma"][2].as_f64().expect("own σ of b"))
+        .collect();
+    let spread = own_b.iter().copied().fold(0.0, f64::max)
+        / own_b.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(spread > 1.3, "the phases' own σ of b: {own_b:?}");
+    for row in rows {
+        assert_eq!(row["dof"].as_u64(), Some(6), "{row}");
+        assert_eq!(row["agree"].as_bool(), Some(true), "{row}");
+    }
+    let checks = v["checks"].as_array().unwrap();
+    assert!(
+        checks.iter().all(|c| {
+            let m = c["message"].as_str().unwrap();
+            !m.contains("disagree beyond") && !m.contains("widened")
+        }),
+        "{checks:?}"
+    );
+    cleanup(&path);
+}
+
+#[test]
 fn too_many_phases_and_several_lasers_are_refused_with_the_way_out() {
     let (path, _) = simulated_log("all-pairs-refused", "turtlebot", 20.0, 42, |_| {});
     let log = path.to_str().unwrap();

@@ -10,7 +10,7 @@ use crate::consistency::Consistency;
 use crate::error::PipelineError;
 use crate::finding::{Finding, FindingKind};
 use crate::lasers::{comparison_options, solve, LaserSetup, Solved};
-use crate::log_agreement::{check_log, information_shares};
+use crate::log_agreement::{check_log, check_phase, information_shares};
 use crate::options::{Options, MIN_SAMPLES};
 use crate::phase_correlation::PhaseCorrelation;
 use crate::progress::Progress;
@@ -66,6 +66,9 @@ pub struct JointOutcome {
     /// Per log given in phases: how much its phases share their errors (the joint σ
     /// are scaled by the largest factor).
     pub phase_correlations: Vec<(String, PhaseCorrelation)>,
+    /// The logs are the phases of one log ([`calibrate_log_phases`] with one log
+    /// given): each is compared as a phase ([`crate::log_agreement::check_phase`]).
+    pub phases_of_one_log: bool,
 }
 
 /// The phases of one log given (`--all-pairs`, [`crate::phases`]): the logs of a
@@ -275,6 +278,19 @@ fn calibrate_joint(
             .filter_map(|(g, (_, c))| c.map(|c| (g.name.clone(), c)))
             .collect(),
     };
+    // The phases of one log are compared by the joint covariance before the widening
+    // for their shared errors ([`crate::log_agreement::check_phase`]), and their
+    // spread judged by it.
+    let phases_of_one_log = one_log_in_phases && solved.lasers.is_none();
+    let joint_of_phases = phases_of_one_log.then(|| solved.first.clone());
+    let phases_alike: Vec<Calibration> = joint_of_phases
+        .iter()
+        .flat_map(|joint| {
+            outcomes
+                .iter()
+                .map(|o| crate::log_agreement::as_exchangeable_phase(&o.calibration, joint))
+        })
+        .collect();
     let shared_factor = phase_correlations
         .iter()
         .map(|(_, c)| c.sigma_factor)
@@ -311,7 +327,10 @@ fn calibrate_joint(
                 solved.lasers.is_some() && laser_of_log.iter().filter(|&&j| j == k).count() == 1;
             let constraints = lasers.constraints_of(k, &solve_options.constraints);
             let compared = comparison_options(&solve_options, constraints, &view, alone);
-            check_log(&o.calibration, &view, &compared, name, alone)
+            match &joint_of_phases {
+                Some(joint) => check_phase(&o.calibration, joint, &compared, name),
+                None => check_log(&o.calibration, &view, &compared, name, alone),
+            }
         })
         .collect();
     let phase_groups: Vec<PhaseGroupCheck> = groups
@@ -350,7 +369,14 @@ fn calibrate_joint(
     if lasers.is_none() {
         // Logs that disagree widen the joint σ to their spread: the logs given when
         // they are phases, else each log.
-        let compared: Vec<(&Calibration, &Consistency)> = if phase_groups.is_empty() {
+        let what = if phases_alike.is_empty() {
+            "logs"
+        } else {
+            "phases"
+        };
+        let compared: Vec<(&Calibration, &Consistency)> = if !phases_alike.is_empty() {
+            phases_alike.iter().zip(&agreements).collect()
+        } else if phase_groups.is_empty() {
             outcomes
                 .iter()
                 .map(|o| &o.calibration)
@@ -362,7 +388,9 @@ fn calibrate_joint(
                 .map(|g| (&g.calibration, &g.agreement))
                 .collect()
         };
-        if let Some(sentence) = crate::log_agreement::widen_to_spread(&mut calibration, &compared) {
+        if let Some(sentence) =
+            crate::log_agreement::widen_to_spread(&mut calibration, &compared, what)
+        {
             health.push(Finding::warning(FindingKind::LogAgreement, sentence));
         }
     }
@@ -472,6 +500,7 @@ fn calibrate_joint(
         lasers,
         phase_groups,
         phase_correlations,
+        phases_of_one_log,
     })
 }
 

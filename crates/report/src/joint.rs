@@ -412,6 +412,11 @@ fn agreement_finding(
         Consistency::Checked(h) if h.agree => {
             Finding::note(FindingKind::LogAgreement, h.sentence.clone())
         }
+        // A phase of the log: its sentence says what a phase's disagreement means, and
+        // the calibration is the log's.
+        Consistency::Checked(h) if joint.phases_of_one_log => {
+            Finding::warning(FindingKind::LogAgreement, h.sentence.clone())
+        }
         Consistency::Checked(h) => {
             let laser = joint.laser_of_log.get(index).copied().unwrap_or(0);
             let shares_laser = joint
