@@ -5,6 +5,8 @@
 //! the log or acts unevenly on it (an unmodelled sweep, a clock offset, wheel slip,
 //! a sensor mounting that moved), even when each half, and the whole, look fine.
 
+use crate::match_quality::scale_by_self_check;
+use crate::self_check::MatchSelfCheck;
 use nalgebra::DMatrix;
 use odocal_solver::{
     calibrate, Calibration, Constraint, Sample, SolveOptions, Verdict, PARAMETER_NAMES,
@@ -56,15 +58,29 @@ pub struct HalvesCheck {
 }
 
 /// Calibrates the first and the second half of `samples` (in time order) with
-/// `options` (weak halves still give numbers) and compares them.
-pub fn check_halves(samples: &[Sample], options: &SolveOptions) -> Consistency {
+/// `options` (weak halves still give numbers) and compares them. Each half's σ are
+/// scaled by the matcher's own error `self_check` (the log's, when it had enough
+/// scan triples) as the log's σ are ([`crate::match_quality::sigma_inflation`]
+/// against the half's scan-matching noise): without it, a log whose matches err more
+/// than their residuals show had its halves judged by σ known to be too small (20 %
+/// of simulated rover logs disagreed, 6 of 30; 2 with the scaling).
+pub fn check_halves(
+    samples: &[Sample],
+    options: &SolveOptions,
+    self_check: Option<&MatchSelfCheck>,
+) -> Consistency {
     let half = samples.len() / 2;
     let opts = SolveOptions {
         accept_weak: true,
         ..*options
     };
     let solve = |part: &[Sample], name: &str| {
-        calibrate(part, &opts).map_err(|e| format!("the {name} half alone: {e}"))
+        calibrate(part, &opts)
+            .map(|mut c| {
+                scale_by_self_check(&mut c, self_check);
+                c
+            })
+            .map_err(|e| format!("the {name} half alone: {e}"))
     };
     // Both halves are solved (on two threads when the pool has them).
     match rayon::join(
@@ -277,10 +293,17 @@ fn disagreement_sentence(
     let clock = "a clock offset between laser and encoders (try --estimate-time-offset)";
     let slip = "wheel slip or a changing load or tyre";
     let mounting = "a sensor mounting that moved during the log";
+    let drift = "a laser whose ranges drifted in scale during the log (one still warming \
+                 up: start recording after it has run for some minutes)";
+    // Both radii moved the same way: a change of scale (of the ranges, or of the
+    // wheels' rolling radius).
+    let scaled = radii && free.contains(&0) && free.contains(&1) && z[0] * z[1] > 0.0;
     let causes: Vec<&str> = if laser {
         vec![sweep, clock, mounting, slip]
     } else if base {
         vec![sweep, clock, slip, mounting]
+    } else if scaled {
+        vec![slip, drift, clock, sweep, mounting]
     } else if radii {
         vec![slip, clock, sweep, mounting]
     } else {
@@ -339,7 +362,7 @@ mod tests {
     fn same_robot_agrees_and_a_moved_sensor_does_not() {
         let robot = robot();
         let opts = SolveOptions::default();
-        let Consistency::Checked(same) = check_halves(&drive(&robot, &robot), &opts) else {
+        let Consistency::Checked(same) = check_halves(&drive(&robot, &robot), &opts, None) else {
             panic!("not checked")
         };
         assert!(same.agree, "{}", same.sentence);
@@ -348,7 +371,7 @@ mod tests {
             laser: Pose2::new(0.1, 0.035, 0.5),
             ..robot
         };
-        let Consistency::Checked(c) = check_halves(&drive(&robot, &moved), &opts) else {
+        let Consistency::Checked(c) = check_halves(&drive(&robot, &moved), &opts, None) else {
             panic!("not checked")
         };
         assert!(!c.agree, "{}", c.sentence);
@@ -357,16 +380,64 @@ mod tests {
         // Holding b removes it from the χ².
         let mut held = opts;
         held.constraints.0[2] = odocal_solver::Constraint::Held(0.3);
-        let Consistency::Checked(h) = check_halves(&drive(&robot, &robot), &held) else {
+        let Consistency::Checked(h) = check_halves(&drive(&robot, &robot), &held, None) else {
             panic!("not checked")
         };
         assert_eq!((h.dof, h.z[2]), (5, 0.0));
         // Too few samples for a half: not available, with the reason.
         let few = drive(&robot, &robot)[..16].to_vec();
         assert!(matches!(
-            check_halves(&few, &opts),
+            check_halves(&few, &opts, None),
             Consistency::NotAvailable { .. }
         ));
+    }
+
+    #[test]
+    fn the_halves_are_judged_with_the_matchers_own_error_as_the_log_is() {
+        let robot = robot();
+        let opts = SolveOptions::default();
+        // The laser moved by 0.6 mm sideways between the halves.
+        let moved = Params {
+            laser: Pose2::new(0.1, 0.0206, 0.5),
+            ..robot
+        };
+        let samples = drive(&robot, &moved);
+        let Consistency::Checked(plain) = check_halves(&samples, &opts, None) else {
+            panic!("not checked")
+        };
+        // A matcher whose error per pair is 3× the halves' scan-matching noise: every
+        // σ of the log is 3× larger, and so are the halves'.
+        let sm = calibrate(&samples, &opts).expect("calibrates").sm_sigma;
+        let check = MatchSelfCheck {
+            triples: 60,
+            tried: 60,
+            xy_m: 3.0 * (0.5 * (sm[0] * sm[0] + sm[1] * sm[1])).sqrt(),
+            theta_rad: 3.0 * sm[2],
+            range_noise_m: 0.01,
+            ray_spacing_rad: 0.006,
+            sigma_factor: 1.0,
+        };
+        let Consistency::Checked(scaled) = check_halves(&samples, &opts, Some(&check)) else {
+            panic!("not checked")
+        };
+        assert!(!plain.agree && scaled.agree, "{plain:?}\n{scaled:?}");
+        let ratio = plain.chi2 / scaled.chi2;
+        assert!(
+            (8.0..16.0).contains(&ratio),
+            "χ² {} → {}",
+            plain.chi2,
+            scaled.chi2
+        );
+        // Within the self-check's sampling error of the noise: not scaled.
+        let close = MatchSelfCheck {
+            xy_m: check.xy_m / 3.0,
+            theta_rad: check.theta_rad / 3.0,
+            ..check
+        };
+        assert_eq!(
+            check_halves(&samples, &opts, Some(&close)),
+            Consistency::Checked(plain)
+        );
     }
 
     #[test]
@@ -438,5 +509,17 @@ mod tests {
             11.83,
         );
         assert!(radii.contains("likely causes: wheel slip"), "{radii}");
+        // Both radii larger in one half: a change of scale, the laser's drift among
+        // the causes; opposite ways, not.
+        assert!(radii.contains("drifted in scale"), "{radii}");
+        let opposite = disagreement_sentence(
+            "the halves",
+            &[0, 1],
+            &[3.5, -3.2, 0.0, 0.0, 0.0, 0.0],
+            15.0,
+            2,
+            11.83,
+        );
+        assert!(!opposite.contains("drifted"), "{opposite}");
     }
 }

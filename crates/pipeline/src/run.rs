@@ -745,7 +745,13 @@ pub fn calibrate_log(
     // The halves' check needs only the samples: it runs beside the final solve.
     let (calibration, consistency) = rayon::join(
         || solve(&synced, opts),
-        || check_halves(&samples, &opts.solve_options()),
+        || {
+            check_halves(
+                &samples,
+                &opts.solve_options(),
+                synced.match_self_check.as_ref(),
+            )
+        },
     );
     let calibration = calibration.map_err(|e| PipelineError::with_faults(e, &findings))?;
     if let Some(check) = synced.match_self_check.as_mut() {
