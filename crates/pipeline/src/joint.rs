@@ -327,9 +327,9 @@ fn calibrate_joint(
                 solved.lasers.is_some() && laser_of_log.iter().filter(|&&j| j == k).count() == 1;
             let constraints = lasers.constraints_of(k, &solve_options.constraints);
             let compared = comparison_options(&solve_options, constraints, &view, alone);
-            match &joint_of_phases {
-                Some(joint) => check_phase(&o.calibration, joint, &compared, name),
-                None => check_log(&o.calibration, &view, &compared, name, alone),
+            match (&joint_of_phases, phases_alike.get(index)) {
+                (Some(joint), Some(alike)) => check_phase(alike, joint, &compared, name),
+                _ => check_log(&o.calibration, &view, &compared, name, alone),
             }
         })
         .collect();

@@ -89,18 +89,17 @@ fn check_with_cause(
     Consistency::Checked(Box::new(check))
 }
 
-/// Compares one phase `phase` of a log given in phases (`--all-pairs`, one log) with
-/// the log's joint estimate `joint` (before any widening for the phases' shared
-/// errors), by the joint covariance for the phase's share of the samples
-/// ([`as_exchangeable_phase`]); a disagreement names the causes a phase can have.
+/// Compares one phase of a log given in phases (`--all-pairs`, one log), `alike` as
+/// [`as_exchangeable_phase`] makes it, with the log's joint estimate `joint` (before
+/// any widening for the phases' shared errors); a disagreement names the causes a
+/// phase can have.
 pub fn check_phase(
-    phase: &Calibration,
+    alike: &Calibration,
     joint: &Calibration,
     options: &SolveOptions,
     name: &str,
 ) -> Consistency {
-    let alike = as_exchangeable_phase(phase, joint);
-    check_with_cause(&alike, joint, options, name, false, Some(PHASE_CAUSE))
+    check_with_cause(alike, joint, options, name, false, Some(PHASE_CAUSE))
 }
 
 /// Why one phase of a log disagrees with the others: not another robot or mounting.
