@@ -310,7 +310,12 @@ fn apply(lines: &mut Vec<String>, e: &Edit) {
                 .skip(l % n)
                 .find(|x| x.starts_with("ENCODER"))
             {
-                with_tokens(line, |toks| toks[1] = v.to_string());
+                // A line an earlier edit cut to its name keeps no count to replace.
+                with_tokens(line, |toks| {
+                    if let Some(t) = toks.get_mut(1) {
+                        *t = v.to_string();
+                    }
+                });
             }
         }
         Edit::FrozenScan(l) => {
