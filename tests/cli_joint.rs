@@ -67,6 +67,18 @@ fn a_log_that_fails_is_named() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(err.contains("empty.log"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
+    // A log too short to calibrate: named, its reason said once (it was said twice:
+    // by the error and again by its source).
+    let short = "fixtures/bags/khepera_db3_zstd_file";
+    for extra in [None, Some("--all-pairs")] {
+        let mut args = vec!["calibrate", "fixtures/demo.log", short];
+        args.extend(extra);
+        let o = odocal(&args);
+        let err = stderr(&o);
+        assert!(!o.status.success(), "{err}");
+        assert!(err.contains(&format!("error: {short}")), "{err}");
+        assert_eq!(err.matches("usable sample(s)").count(), 1, "{err}");
+    }
 }
 
 #[test]

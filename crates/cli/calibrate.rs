@@ -488,6 +488,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                     odocal_pipeline::JointError::Joint(refusal) => {
                         anyhow::Error::from(refusal).context(what)
                     }
+                    // The log's own failure under its name, said once (the error's
+                    // message and its source would each say it).
+                    odocal_pipeline::JointError::Log { name, source, .. } => {
+                        anyhow::Error::from(source).context(name)
+                    }
                     e => e.into(),
                 }
             })?;
