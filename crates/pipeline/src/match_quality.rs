@@ -6,11 +6,12 @@
 //! scan matcher's error and the odometry's: one match's error, measured by the closure
 //! of scan triples, can be at most that. On clean simulated logs it is 0.2–0.5× of it
 //! (Khepera, TurtleBot, Pioneer, seeds 1–5), on the real MinesRover logs 0.25–0.55×.
-//! When it is larger on some axis, beyond the self-check's own sampling error (a
-//! factor `1 + 2/√triples`), the residuals do not show all of the matcher's error
-//! (part of it is absorbed by the parameters), and the σ, which scale with the noise
-//! level, are multiplied by the largest ratio over the axes (translation per axis
-//! against the mean of x and y; rotation against θ). The closure is a lower bound
+//! When it is larger on some axis, beyond the self-check's own sampling error (its
+//! standard error `1/√triples` on the ratio), the residuals do not show all of the
+//! matcher's error (part of it is absorbed by the parameters), and the σ, which scale
+//! with the noise level, are multiplied by the largest ratio over the axes
+//! (translation per axis against the mean of x and y; rotation against θ), weighed by
+//! the evidence that it exceeds 1 ([`sigma_inflation`]). The closure is a lower bound
 //! (matches of one scan share errors), so the check can only say that the model is
 //! too small, never that it is too large. (Against the model's part not shared
 //! through scans, `SharedScanNoise::per_sample`, which the closure measures more
@@ -42,9 +43,13 @@ use crate::self_check::MatchSelfCheck;
 /// lies between, a compromise, not a law.
 pub const COMPARABLE_SHARE: f64 = 0.12;
 
-/// The factor by which the σ are multiplied: the largest ratio of one match's error
-/// (the self-check) to the solver's scan-matching noise `sm_sigma` (x, y, θ) over the
-/// axes, when it exceeds 1 by more than the self-check's sampling error; else 1.
+/// The factor by which the σ are multiplied: the largest ratio `q` of one match's
+/// error (the self-check) to the solver's scan-matching noise `sm_sigma` (x, y, θ)
+/// over the axes, weighed by the evidence that it exceeds 1 — `1 + w·(q − 1)`, `w` 0
+/// while `q` is within one standard error of the self-check (`1/√triples`) of 1, 1
+/// from three, linear between — so that the σ do not jump where `q` crosses a
+/// threshold (a switch at two standard errors multiplied them by 1 or by 1.26 on
+/// either side of it with 60 triples; the sideways slide is weighed the same way).
 pub fn sigma_inflation(check: &MatchSelfCheck, sm_sigma: [f64; 3]) -> f64 {
     let model_xy = (0.5 * (sm_sigma[0].powi(2) + sm_sigma[1].powi(2))).sqrt();
     let ratio = |measured: f64, model: f64| {
@@ -55,13 +60,17 @@ pub fn sigma_inflation(check: &MatchSelfCheck, sm_sigma: [f64; 3]) -> f64 {
         }
     };
     let largest = ratio(check.xy_m, model_xy).max(ratio(check.theta_rad, sm_sigma[2]));
-    let tolerance = 1.0 + 2.0 / (check.triples.max(1) as f64).sqrt();
-    if largest > tolerance {
-        largest
-    } else {
-        1.0
-    }
+    let standard_error = 1.0 / (check.triples.max(1) as f64).sqrt();
+    let evidence = (largest - 1.0) / standard_error;
+    let weight = ((evidence - EVIDENCE_NONE) / (EVIDENCE_FULL - EVIDENCE_NONE)).clamp(0.0, 1.0);
+    1.0 + weight * (largest - 1.0).max(0.0)
 }
+
+/// Standard errors of the self-check by which its ratio must exceed 1 for the σ to
+/// grow at all …
+const EVIDENCE_NONE: f64 = 1.0;
+/// … and to grow by the full ratio.
+const EVIDENCE_FULL: f64 = 3.0;
 
 /// Scales `calibration`'s σ by the matcher's own error (`check`, when the log had
 /// enough scan triples): [`sigma_inflation`] against its scan-matching noise. Returns
@@ -208,8 +217,18 @@ mod tests {
         let model = [0.004, 0.002, 0.01];
         // Below the model on every axis: unchanged.
         assert_eq!(sigma_inflation(&check(0.001, 0.005), model), 1.0);
-        // Within the sampling error of 60 triples (1 + 2/√60 = 1.26): unchanged.
-        assert_eq!(sigma_inflation(&check(0.001, 0.012), model), 1.0);
+        // Within one standard error of 60 triples (1 + 1/√60 = 1.13): unchanged.
+        assert_eq!(sigma_inflation(&check(0.001, 0.0112), model), 1.0);
+        // Between one and three: part of the ratio, growing with it without a jump.
+        let se = 1.0 / 60f64.sqrt();
+        let at = |q: f64| sigma_inflation(&check(0.001, 0.01 * q), model);
+        assert!((at(1.0 + 2.0 * se) - (1.0 + se)).abs() < 1e-12);
+        let steps: Vec<f64> = (0..=40).map(|i| at(1.0 + 0.1 * se * i as f64)).collect();
+        for w in steps.windows(2) {
+            assert!(w[1] >= w[0] && w[1] - w[0] < 0.05, "{steps:?}");
+        }
+        // From three standard errors on: the full ratio.
+        assert!((at(1.0 + 3.0 * se) - (1.0 + 3.0 * se)).abs() < 1e-12);
         // Translation 2× the RMS of the x and y model (√((16+4)/2) mm = 3.16 mm).
         let k = sigma_inflation(&check(2.0 * 10f64.sqrt() * 1e-3, 0.005), model);
         assert!((k - 2.0).abs() < 1e-12, "{k}");
