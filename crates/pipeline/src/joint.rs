@@ -177,7 +177,7 @@ pub fn calibrate_log_phases(
 
 /// The joint calibration: [`calibrate_logs_with_lasers`], with each of `groups` (the
 /// phases of one log; empty: none) compared with the joint estimate as one log when
-/// there are several groups.
+/// there are several groups. Logs in phases are one laser's (`calibrate_log_phases`).
 fn calibrate_joint(
     logs: &[(&str, &Log)],
     lasers: &LaserSetup,
@@ -264,11 +264,9 @@ fn calibrate_joint(
     // One log's phases share their errors where they overlap in time: the joint σ
     // scaled by the largest log's factor before anything is compared with them.
     let phase_correlations: Vec<(String, PhaseCorrelation)> = match groups {
-        _ if solved.lasers.is_some() => Vec::new(),
         [one] if one_log_in_phases => {
-            let members: Vec<&Outcome> = outcomes.iter().collect();
             let residuals = slide_residuals(&solved.first, &samples, opts);
-            crate::phase_correlation::measure(&members, &residuals, &solved.first.used)
+            crate::phase_correlation::measure(&all, &residuals, &solved.first.used)
                 .map(|c| vec![(one.name.clone(), c)])
                 .unwrap_or_default()
         }
@@ -281,8 +279,7 @@ fn calibrate_joint(
     // The phases of one log are compared by the joint covariance before the widening
     // for their shared errors ([`crate::log_agreement::check_phase`]), and their
     // spread judged by it.
-    let phases_of_one_log = one_log_in_phases && solved.lasers.is_none();
-    let joint_of_phases = phases_of_one_log.then(|| solved.first.clone());
+    let joint_of_phases = one_log_in_phases.then(|| solved.first.clone());
     let phases_alike: Vec<Calibration> = joint_of_phases
         .iter()
         .flat_map(|joint| {
@@ -500,7 +497,7 @@ fn calibrate_joint(
         lasers,
         phase_groups,
         phase_correlations,
-        phases_of_one_log,
+        phases_of_one_log: one_log_in_phases,
     })
 }
 

@@ -379,22 +379,9 @@ fn phase_group_rows(joint: &JointOutcome) -> Vec<LogRow> {
 /// A log given, its phases together, against the joint estimate as a finding: a
 /// warning, with what to do, when it disagrees.
 fn phase_group_finding(group: &odocal_pipeline::PhaseGroupCheck) -> Finding {
-    match &group.agreement {
-        Consistency::Checked(h) if h.agree => {
-            Finding::note(FindingKind::LogAgreement, h.sentence.clone())
-        }
-        Consistency::Checked(h) => Finding::warning(
-            FindingKind::LogAgreement,
-            format!(
-                "{}; if it was recorded on another floor or on another robot, calibrate \
-                 without it, or on its own (`odocal calibrate {} --all-pairs`)",
-                h.sentence, group.name
-            ),
-        ),
-        Consistency::NotAvailable { reason } => {
-            Finding::note(FindingKind::LogAgreement, reason.clone())
-        }
-    }
+    as_finding(&group.agreement, || {
+        other_robot_advice(&format!("{} --all-pairs", group.name))
+    })
 }
 
 /// One log's agreement as a finding: a warning, with what to do, when it disagrees:
@@ -407,46 +394,59 @@ fn agreement_finding(
     files: &Files,
     joint: &JointOutcome,
 ) -> Finding {
-    let name = &names[index];
+    // A phase of the log: its sentence says what a phase's disagreement means, and
+    // the calibration is the log's.
+    if joint.phases_of_one_log {
+        return as_finding(agreement, String::new);
+    }
+    as_finding(agreement, || {
+        let name = &names[index];
+        let laser = joint.laser_of_log.get(index).copied().unwrap_or(0);
+        let shares_laser = joint
+            .laser_of_log
+            .iter()
+            .enumerate()
+            .any(|(i, &k)| k == laser && files.file_of[i] != files.file_of[index]);
+        let own = if shares_laser {
+            format!(
+                "; if {name}'s laser was mounted elsewhere, give it its own ℓ (`{}`, with \
+                 the other options you gave)",
+                files.own_laser_command(files.file_of[index])
+            )
+        } else {
+            String::new()
+        };
+        format!(
+            "{own}{}",
+            other_robot_advice(&files.files[files.file_of[index]])
+        )
+    })
+}
+
+/// An agreement as a finding: a note when it agrees or was not compared; a warning
+/// when it disagrees, its sentence followed by `advice()`.
+fn as_finding(agreement: &Consistency, advice: impl FnOnce() -> String) -> Finding {
     match agreement {
         Consistency::Checked(h) if h.agree => {
             Finding::note(FindingKind::LogAgreement, h.sentence.clone())
         }
-        // A phase of the log: its sentence says what a phase's disagreement means, and
-        // the calibration is the log's.
-        Consistency::Checked(h) if joint.phases_of_one_log => {
-            Finding::warning(FindingKind::LogAgreement, h.sentence.clone())
-        }
-        Consistency::Checked(h) => {
-            let laser = joint.laser_of_log.get(index).copied().unwrap_or(0);
-            let shares_laser = joint
-                .laser_of_log
-                .iter()
-                .enumerate()
-                .any(|(i, &k)| k == laser && files.file_of[i] != files.file_of[index]);
-            let own = if shares_laser {
-                format!(
-                    "if {name}'s laser was mounted elsewhere, give it its own ℓ (`{}`, with \
-                     the other options you gave); ",
-                    files.own_laser_command(files.file_of[index])
-                )
-            } else {
-                String::new()
-            };
-            let file = &files.files[files.file_of[index]];
-            Finding::warning(
-                FindingKind::LogAgreement,
-                format!(
-                    "{}; {own}if it was recorded on another floor or on another robot, \
-                     calibrate without it, or on its own (`odocal calibrate {file}`)",
-                    h.sentence
-                ),
-            )
-        }
+        Consistency::Checked(h) => Finding::warning(
+            FindingKind::LogAgreement,
+            format!("{}{}", h.sentence, advice()),
+        ),
         Consistency::NotAvailable { reason } => {
             Finding::note(FindingKind::LogAgreement, reason.clone())
         }
     }
+}
+
+/// "; if it was recorded on another floor …": what to do with a log (calibrated on
+/// its own by `odocal calibrate ARGS`) that disagrees with the others.
+fn other_robot_advice(args: &str) -> String {
+    format!(
+        "; if it was recorded on another floor or on another robot, calibrate without it, \
+         or on its own (`odocal calibrate {args}`)"
+    )
 }
 
 /// The log files of a joint calibration and the scan topics read from them.
