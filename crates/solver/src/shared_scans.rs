@@ -342,6 +342,8 @@ struct LongRun {
     /// Per component: the mean square of the window sums over its part `m·Λ̂_cc`
     /// (the rest is the scans' shared error at the windows' ends).
     inflation: Vector3<f64>,
+    /// Per component: the mean square of the window sums.
+    mean_square: Vector3<f64>,
     /// Overlapping windows of `window` samples out of `samples`.
     samples: usize,
     window: usize,
@@ -355,13 +357,29 @@ impl LongRun {
     /// ν₀ / (inflation)². An error divided by a σ estimated with ν degrees of
     /// freedom has variance ν/(ν − 2) (Student's t): each component of Λ̂ is
     /// widened by that much.
+    ///
+    /// Where Λ̂ is within its own sampling noise of zero (a short log: a few
+    /// windows whose sums are mostly their end scans' errors) that rule shrinks
+    /// with it, to nothing at Λ̂ = 0, and everything that sums over samples would
+    /// rest on the shared errors alone, which cancel along a chain: a simulated
+    /// 20 s Khepera log (49 samples, Λ̂ clamped to zero) put ℓy 4.7σ from the
+    /// truth. So no component is taken below one standard error of its estimate,
+    /// the window sums' mean square over `m` times `√(2/ν₀)`: the largest value
+    /// the data cannot tell from zero. On logs of a few hundred samples Λ̂ stands
+    /// well above it and nothing changes.
     fn widened(&self) -> Matrix3<f64> {
         let nu0 = 1.5 * self.samples as f64 / self.window as f64;
         let scale = self.inflation.map(|r| {
             let nu = nu0 / (r * r);
             (nu / (nu - 2.0).max(0.2)).sqrt()
         });
-        Matrix3::from_diagonal(&scale) * self.lambda * Matrix3::from_diagonal(&scale)
+        let widened = Matrix3::from_diagonal(&scale) * self.lambda * Matrix3::from_diagonal(&scale);
+        let standard_error = self
+            .mean_square
+            .map(|q| q / self.window as f64 * (2.0 / nu0).sqrt());
+        // A non-negative diagonal added: the sum stays positive semi-definite.
+        let floor = Vector3::from_fn(|c, _| (standard_error[c] - widened[(c, c)]).max(0.0));
+        widened + Matrix3::from_diagonal(&floor)
     }
 }
 
@@ -453,6 +471,7 @@ fn long_run_covariance(
     LongRun {
         lambda,
         inflation,
+        mean_square: squares / windows as f64,
         samples: k_all,
         window,
     }
@@ -461,6 +480,47 @@ fn long_run_covariance(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A long-run estimate at zero from three windows is not taken at its word: it
+    /// is raised to one standard error of itself; one well above that is widened
+    /// by Student's rule alone.
+    #[test]
+    fn a_long_run_estimate_within_its_noise_of_zero_is_floored() {
+        let (samples, window) = (49, 16);
+        let nu0 = 1.5 * samples as f64 / window as f64;
+        let mean_square = Vector3::new(4e-7, 3e-7, 2e-7);
+        let zero = LongRun {
+            lambda: Matrix3::zeros(),
+            inflation: Vector3::repeat(1.0),
+            mean_square,
+            samples,
+            window,
+        };
+        let w = zero.widened();
+        for c in 0..3 {
+            let se = mean_square[c] / window as f64 * (2.0 / nu0).sqrt();
+            assert!(
+                (w[(c, c)] - se).abs() < 1e-12 * se,
+                "{c}: {} vs {se}",
+                w[(c, c)]
+            );
+        }
+        let (samples, window) = (1500, 38);
+        let lambda = Matrix3::from_diagonal(&Vector3::new(1e-8, 2e-8, 3e-8));
+        let clear = LongRun {
+            lambda,
+            inflation: Vector3::repeat(1.2),
+            mean_square: lambda.diagonal() * (window as f64 * 1.2),
+            samples,
+            window,
+        };
+        let nu = 1.5 * samples as f64 / window as f64 / 1.44;
+        let w = clear.widened();
+        for c in 0..3 {
+            let want = lambda[(c, c)] * nu / (nu - 2.0);
+            assert!((w[(c, c)] - want).abs() < 1e-9 * want, "{c}");
+        }
+    }
 
     #[test]
     fn maps_are_the_first_order_pose_compositions() {
