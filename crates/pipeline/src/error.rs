@@ -146,6 +146,25 @@ impl PipelineError {
                     diagnosis,
                 };
             }
+            // A clock offset found is estimated and applied before the verdicts (or,
+            // known, only reported): the motion is what it is at either offset, so
+            // the offset is never why the data do not determine a parameter.
+            PipelineError::NotDetermined {
+                parameters,
+                sentence,
+                mut diagnosis,
+            } if findings
+                .iter()
+                .filter(|f| f.severity == crate::finding::Severity::Warning)
+                .all(|f| f.kind == crate::finding::FindingKind::ClockOffset) =>
+            {
+                diagnosis.faults = Some(faults);
+                return PipelineError::NotDetermined {
+                    parameters,
+                    sentence,
+                    diagnosis,
+                };
+            }
             other => other,
         };
         PipelineError::DataFault {
@@ -380,6 +399,39 @@ mod tests {
             ),
             "{said}"
         );
+    }
+
+    #[test]
+    fn a_clock_offset_is_not_why_the_motion_leaves_parameters_weak() {
+        use crate::finding::{Finding, FindingKind};
+        let refusal = || PipelineError::NotDetermined {
+            parameters: vec!["b".into(), "l_x".into(), "l_y".into()],
+            sentence: "the motion does not excite them (0 spins in place, 46 straight)".into(),
+            diagnosis: Box::default(),
+        };
+        let offset = Finding::warning(
+            FindingKind::ClockOffset,
+            "the laser clock looks offset from the encoder clock by about +0.19 s",
+        );
+        let said = refusal()
+            .with_faults(std::slice::from_ref(&offset))
+            .to_string();
+        assert!(
+            said.starts_with("the data do not determine b, l_x, l_y"),
+            "{said}"
+        );
+        assert!(!said.contains("as a result"), "{said}");
+        assert!(
+            said.ends_with(
+                "; also found in the log (not the cause): the laser clock looks offset from \
+                 the encoder clock by about +0.19 s"
+            ),
+            "{said}"
+        );
+        // A fault that takes samples out may be the cause: named first, as before.
+        let gap = Finding::warning(FindingKind::Gap, "the encoder stream has a 12 s hole");
+        let said = refusal().with_faults(&[offset, gap]).to_string();
+        assert!(said.starts_with("the log has data faults:"), "{said}");
     }
 
     fn too_few(discards: &[(DiscardReason, usize)], refused: &[(Rejection, usize)]) -> String {

@@ -658,9 +658,13 @@ pub fn calibrate_log(
         ),
         _ => None,
     };
-    findings.extend(found.map(|q| {
+    // Said once the estimate has confirmed it (or at once when only reported).
+    let mut found_finding = found.map(|q| {
         health::clock_offset::found_offset_finding(&q, synced.time_offset, search_range.is_some())
-    }));
+    });
+    if search_range.is_none() {
+        findings.extend(found_finding.take());
+    }
     // A swept log is matched again after compensating with the refined estimate.
     let sweep = has_sweep(&log.scans);
     // For the solves that are never judged (before the clock offset is estimated, and
@@ -685,10 +689,23 @@ pub fn calibrate_log(
         let t = Instant::now();
         let start = opts.time_offset;
         let est = estimate_time_offset(log, &synced, opts, start, range, &base)?;
-        findings.extend(edge_warning(log, &synced, start, range, est.offset));
-        resynchronize(log, &mut synced, est.offset);
+        match (found, found_finding.take()) {
+            // Estimated only because the quick check found an offset, and the estimate
+            // does not confirm it: the clocks agree, calibrated at the offset in use.
+            (Some(q), Some(_))
+                if opts.estimate_time_offset.is_none()
+                    && health::clock_offset::estimate_agrees(&est, start) =>
+            {
+                findings.push(health::clock_offset::unconfirmed_finding(&q, start, &est));
+            }
+            (_, warning) => {
+                findings.extend(warning);
+                findings.extend(edge_warning(log, &synced, start, range, est.offset));
+                resynchronize(log, &mut synced, est.offset);
+                offset = Some(est);
+            }
+        }
         timing.time_offset += t.elapsed().as_secs_f64();
-        offset = Some(est);
     }
     let t_solve = Instant::now();
     if opts.second_pass || sweep {
