@@ -683,23 +683,22 @@ pub fn calibrate_log(
         )?;
         // Estimate first, on an estimate not yet judged: the verdicts come after.
         let t = Instant::now();
-        let base =
-            solve(&synced, &lenient).map_err(|e| PipelineError::with_faults(e, &findings))?;
+        let base = solve(&synced, &lenient).map_err(|e| {
+            // Not yet confirmed, but what the quick check found goes with a refusal.
+            let all: Vec<_> = findings.iter().chain(&found_finding).cloned().collect();
+            PipelineError::with_faults(e, &all)
+        })?;
         timing.solve += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let start = opts.time_offset;
         let est = estimate_time_offset(log, &synced, opts, start, range, &base)?;
-        match (found, found_finding.take()) {
-            // Estimated only because the quick check found an offset, and the estimate
-            // does not confirm it: the clocks agree, calibrated at the offset in use.
-            (Some(q), Some(_))
-                if opts.estimate_time_offset.is_none()
-                    && health::clock_offset::estimate_agrees(&est, start) =>
-            {
-                findings.push(health::clock_offset::unconfirmed_finding(&q, start, &est));
-            }
-            (_, warning) => {
-                findings.extend(warning);
+        // Estimated only because the quick check found an offset (`found` is `None`
+        // when an estimate was asked for), and the estimate does not confirm it: the
+        // clocks agree, calibrated at the offset in use.
+        match found.filter(|_| health::clock_offset::estimate_agrees(&est, start)) {
+            Some(q) => findings.push(health::clock_offset::unconfirmed_finding(&q, start, &est)),
+            None => {
+                findings.extend(found_finding.take());
                 findings.extend(edge_warning(log, &synced, start, range, est.offset));
                 resynchronize(log, &mut synced, est.offset);
                 offset = Some(est);

@@ -566,14 +566,7 @@ mod tests {
         use Verdict::*;
         assert_eq!(
             v,
-            vec![
-                WellDetermined,
-                Weak,
-                Weak,
-                WellDetermined,
-                Weak,
-                NotExcited
-            ]
+            vec![WellDetermined, Weak, Weak, WellDetermined, Weak, NotExcited]
         );
     }
 

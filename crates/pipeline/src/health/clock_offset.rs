@@ -63,17 +63,12 @@ fn rotations_vary(used: &[&crate::samples::PairSample], theta: &[f64]) -> bool {
     let n = theta.len() as f64;
     let mean = theta.iter().sum::<f64>() / n;
     let spread = (theta.iter().map(|t| (t - mean).powi(2)).sum::<f64>() / n).sqrt();
-    let mut sigmas: Vec<f64> = used
+    let sigmas: Vec<f64> = used
         .iter()
         .map(|s| s.icp.covariance[2][2].sqrt())
         .filter(|s| s.is_finite())
         .collect();
-    if sigmas.is_empty() {
-        return true;
-    }
-    let mid = sigmas.len() / 2;
-    let median = *sigmas.select_nth_unstable_by(mid, f64::total_cmp).1;
-    spread >= MIN_ROTATION_SPREAD * median
+    super::scan_jitter::median(sigmas).is_none_or(|median| spread >= MIN_ROTATION_SPREAD * median)
 }
 
 /// The offset within `center ± range` at which scan-matching rotations and wheel
