@@ -146,9 +146,7 @@ impl PipelineError {
                     diagnosis,
                 };
             }
-            // A clock offset found is estimated and applied before the verdicts (or,
-            // known, only reported): the motion is what it is at either offset, so
-            // the offset is never why the data do not determine a parameter.
+            // No fault found can be why (a clock offset): they are only also found.
             PipelineError::NotDetermined {
                 parameters,
                 sentence,
@@ -156,7 +154,7 @@ impl PipelineError {
             } if findings
                 .iter()
                 .filter(|f| f.severity == crate::finding::Severity::Warning)
-                .all(|f| f.kind == crate::finding::FindingKind::ClockOffset) =>
+                .all(|f| !f.kind.can_leave_parameters_undetermined()) =>
             {
                 diagnosis.faults = Some(faults);
                 return PipelineError::NotDetermined {

@@ -67,6 +67,13 @@ impl FindingKind {
         )
     }
 
+    /// Whether a fault of this kind can be why the data leave parameters undetermined.
+    /// Not a clock offset: one found is estimated and applied before the verdicts (or,
+    /// known, only reported), and the motion is what it is at either offset.
+    pub fn can_leave_parameters_undetermined(self) -> bool {
+        self != FindingKind::ClockOffset
+    }
+
     /// The snake_case name used in the JSON.
     pub fn name(self) -> &'static str {
         match self {
