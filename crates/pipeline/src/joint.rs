@@ -639,7 +639,7 @@ fn sliding_logs(logs: &[(&str, &Log)], outcomes: &[Outcome]) -> Option<String> {
             o.calibration
                 .lateral_slip
                 .as_ref()
-                .is_some_and(|s| s.applied)
+                .is_some_and(crate::lateral_slip::more_likely_than_not)
         })
         .map(|((n, _), _)| *n)
         .collect();

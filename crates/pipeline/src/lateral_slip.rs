@@ -56,6 +56,15 @@ pub fn slide_weight(slip: &LateralSlip) -> f64 {
     ((probability(z * z) - at_zero) / (1.0 - at_zero)).clamp(0.0, 1.0)
 }
 
+/// Whether the robot of `slip`'s log more likely slides than not: the slide is
+/// weighed into its estimate at half or more (from about 2.1σ). A robot that does
+/// not slide has an outward `k` on half its logs, weighed in at a few per cent at
+/// most; naming it as sliding (say, to refuse a model without the slide) would give
+/// a false cause.
+pub fn more_likely_than_not(slip: &LateralSlip) -> bool {
+    slip.applied && slip.weight >= 0.5
+}
+
 /// A weight from which the slide counts as estimated in full in the words (4σ).
 const FULL_WEIGHT: f64 = 0.995;
 
