@@ -69,9 +69,10 @@ impl FindingKind {
 
     /// Whether a fault of this kind can be why the data leave parameters undetermined.
     /// Not a clock offset: one found is estimated and applied before the verdicts (or,
-    /// known, only reported), and the motion is what it is at either offset.
+    /// known, only reported), and the motion is what it is at either offset. Nor exact
+    /// repeats: the record repeated is kept, so no motion is lost with the repeat.
     pub fn can_leave_parameters_undetermined(self) -> bool {
-        self != FindingKind::ClockOffset
+        !matches!(self, FindingKind::ClockOffset | FindingKind::Duplicate)
     }
 
     /// The snake_case name used in the JSON.

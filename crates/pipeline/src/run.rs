@@ -473,7 +473,25 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
         })
         .collect();
     let solve_options = crate::matcher_bias::with_matcher_bias(opts.solve_options(), synced);
-    let mut calibration = odocal_solver::calibrate(&samples, &solve_options)?;
+    // Parameters the motion does not excite are refused below, as weak ones are:
+    // with their cause, and the parameters to hold (the solver alone would only name
+    // them). When the motion excites none, there is nothing to hold: the solver's
+    // refusal.
+    let mut calibration = odocal_solver::calibrate(
+        &samples,
+        &SolveOptions {
+            accept_weak: true,
+            ..solve_options
+        },
+    )?;
+    let excites_none = calibration
+        .observability
+        .parameters
+        .iter()
+        .all(|p| p.verdict == Verdict::NotExcited);
+    if excites_none && !solve_options.accept_weak {
+        odocal_solver::calibrate(&samples, &solve_options)?;
+    }
     crate::lateral_slip::check_and_apply(
         &mut calibration,
         &samples,
