@@ -73,7 +73,9 @@ fn the_phases_of_one_log_are_judged_by_the_joint_sigma_for_their_share() {
         .collect();
     let spread = own_b.iter().copied().fold(0.0, f64::max)
         / own_b.iter().copied().fold(f64::INFINITY, f64::min);
-    assert!(spread > 1.3, "the phases' own σ of b: {own_b:?}");
+    // With the samples weighted by the matcher's covariance of each (stop 47) the
+    // phases' noise estimates differ less: 1.2×.
+    assert!(spread > 1.1, "the phases' own σ of b: {own_b:?}");
     for row in rows {
         assert_eq!(row["dof"].as_u64(), Some(6), "{row}");
         assert_eq!(row["agree"].as_bool(), Some(true), "{row}");
@@ -109,26 +111,34 @@ fn the_real_forward_only_logs_are_offered_every_pair_and_gain_from_it() {
             continue;
         };
         let log = path.to_str().unwrap();
-        // Refused (ℓx weak: no spins in place), with --all-pairs among the ways out.
         let o = odocal(&["calibrate", log]);
         let err = stderr(&o);
-        assert!(!o.status.success(), "{err}");
-        let offered = command_after(&err, "or first, to use every scan pair");
-        assert!(offered.ends_with("--all-pairs"), "{offered}");
-        // Under --json too, beside the command that holds parameters.
-        let o = odocal(&["calibrate", log, "--json"]);
-        assert!(!o.status.success());
-        let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
-        let command = v["all_pairs_command"]
-            .as_str()
-            .unwrap_or_else(|| panic!("{v}"));
-        assert!(command.ends_with("--json --all-pairs"), "{command}");
-        assert!(
-            v["suggested_command"]
+        if name == "exp1.log" {
+            // Measured (stop 47): with the samples weighted by the matcher's
+            // covariance of each, exp1 determines all six (ℓx 162.7 ± 10.1 mm, within
+            // 0.3σ of exp2's 158.1 ± 16.7 mm) and calibrates as it is.
+            assert!(o.status.success(), "{err}");
+        } else {
+            // Refused (b and ℓx weak: no spins in place), with --all-pairs among the
+            // ways out.
+            assert!(!o.status.success(), "{err}");
+            let offered = command_after(&err, "or first, to use every scan pair");
+            assert!(offered.ends_with("--all-pairs"), "{offered}");
+            // Under --json too, beside the command that holds parameters.
+            let o = odocal(&["calibrate", log, "--json"]);
+            assert!(!o.status.success());
+            let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+            let command = v["all_pairs_command"]
                 .as_str()
-                .is_some_and(|c| c.contains("--fix")),
-            "{v}"
-        );
+                .unwrap_or_else(|| panic!("{v}"));
+            assert!(command.ends_with("--json --all-pairs"), "{command}");
+            assert!(
+                v["suggested_command"]
+                    .as_str()
+                    .is_some_and(|c| c.contains("--fix")),
+                "{v}"
+            );
+        }
         // Measured (stop 44): the real logs' phases share their errors where their
         // pairs overlap (residuals correlated by 0.46–0.83 at full overlap: the
         // wheels' slips and scrubs), so every pair narrows the pose σ by less than the
@@ -137,9 +147,13 @@ fn the_real_forward_only_logs_are_offered_every_pair_and_gain_from_it() {
         let one = calibrate_json(&[log, "--accept-weak"]);
         let all = calibrate_json(&[log, "--accept-weak", "--all-pairs"]);
         let (s1, sa) = (pose_sigma(&one), pose_sigma(&all));
+        // Measured (stop 47, the samples weighted by the matcher's covariance of each):
+        // exp2's ℓθ narrows 2.1× (11.4 → 5.4 mrad), a little more than four
+        // independent phases would (the default pairing's 104 samples against every
+        // pair's 441).
         for i in 0..3 {
             assert!(
-                sa[i] < s1[i] && sa[i] > s1[i] / 2.0,
+                sa[i] < s1[i] && sa[i] > s1[i] / 2.5,
                 "{name} pose σ {i}: {} → {}",
                 s1[i],
                 sa[i]
@@ -170,20 +184,26 @@ fn the_real_logs_given_in_phases_are_compared_and_their_spread_kept() {
         return;
     };
     let (exp1, exp2) = (exp1.to_str().unwrap(), exp2.to_str().unwrap());
-    // Default pairing: each log leaves ℓx weak, and is compared on the other five.
+    // Default pairing: exp2 leaves b and ℓx weak and is compared on the other four;
+    // exp1 determines all six (stop 47: the samples weighted by the matcher's
+    // covariance of each).
     let v = calibrate_json(&[exp1, exp2, "--accept-weak"]);
-    for row in v["logs"].as_array().expect("a row per log") {
-        assert_eq!(row["dof"].as_u64(), Some(5), "{row}");
-    }
-    // Each log's two halves leave more weak (measured: ℓx, ℓy in exp1's; b, ℓx, ℓy in
-    // exp2's), and are compared on the others instead of not at all.
+    let dof: Vec<Option<u64>> = v["logs"]
+        .as_array()
+        .expect("a row per log")
+        .iter()
+        .map(|row| row["dof"].as_u64())
+        .collect();
+    assert_eq!(dof, [Some(6), Some(4)], "{}", v["logs"]);
+    // Each log's two halves leave more weak (measured, stop 47: ℓx in exp1's; r_L, b,
+    // ℓx, ℓy in exp2's), and are compared on the others instead of not at all.
     for log in [exp1, exp2] {
         let v = calibrate_json(&[log, "--accept-weak"]);
         let h = &v["consistency"]["checked"];
         let dof = h["dof"]
             .as_u64()
             .unwrap_or_else(|| panic!("{log}: {}", v["consistency"]));
-        assert!((3..6).contains(&dof), "{log}: {h}");
+        assert!((2..6).contains(&dof), "{log}: {h}");
         assert!(
             h["sentence"].as_str().unwrap().contains("weak in a half"),
             "{log}: {h}"
@@ -228,8 +248,10 @@ fn the_real_logs_given_in_phases_are_compared_and_their_spread_kept() {
 #[test]
 fn a_refusal_of_every_pair_gives_the_command_that_holds_what_is_weak() {
     // A rover driven without spins in place (as the real MinesRover logs): ℓx weak even
-    // with every pair (measured: seed 301, 40 s).
-    let (path, truth) = simulated_log("all-pairs-hold", "mines-rover", 40.0, 301, |c| {
+    // with every pair (measured: seed 304, 40 s; since stop 47, with the samples
+    // weighted by the matcher's covariance of each, seeds 301–303, 305 and 306
+    // determine all six, every one within 2.4σ of the truth).
+    let (path, truth) = simulated_log("all-pairs-hold", "mines-rover", 40.0, 304, |c| {
         c.trajectory = odocal_sim::TrajectoryKind::NoSpins;
     });
     let log = path.to_str().unwrap();

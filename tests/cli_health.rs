@@ -51,12 +51,15 @@ fn threads_capped_and_an_impossible_out_refused_before_the_work() {
 fn solve_agrees_with_calibrate_on_its_samples() {
     let (path, _) = simulated_log("cli-health-solve", "khepera-displaced", 60.0, 62, |_| {});
     let dir = path.parent().unwrap().join("out");
+    // `solve` has no sideways slide: calibrate without it (on this log its evidence
+    // weighs it in at 0.7 %, which moves r_L by 1e-7 of itself).
     let c = odocal(&[
         "calibrate",
         path.to_str().unwrap(),
         "--json",
         "--threads",
         "2",
+        "--no-lateral-slip",
         "--out",
         dir.to_str().unwrap(),
     ]);

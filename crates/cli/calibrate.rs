@@ -80,8 +80,10 @@ pub struct Args {
     /// Use the constant-speed formulas instead of the encoder profile.
     #[arg(long)]
     pub constant_speed: bool,
-    /// Weight each sample by the scan matcher's covariance of ŝ (default: noise
-    /// estimated from the residuals, which is what the reported σ assume).
+    /// Weight each sample by the scan matcher's covariance of ŝ as it is (default: the
+    /// noise level estimated from the residuals, shaped per sample by the matcher's
+    /// covariance relative to the typical match's; the reported σ take as much of the
+    /// shapes as the residuals follow).
     #[arg(long)]
     pub icp_covariance: bool,
     /// Use every scan pair the log holds: the scans STRIDE apart from every scan, not

@@ -36,7 +36,9 @@ pub struct Args {
     pub trim: TrimArg,
     /// Weight each sample by its `sm_cov` (the scan matcher's covariance of ŝ) when
     /// every sample has one. Off by default, as in `calibrate` (`--icp-covariance`
-    /// there), so the two give the same numbers on the same samples.
+    /// there), so the two give the same numbers on the same samples: the noise level
+    /// estimated from the residuals, shaped per sample by its `sm_cov` relative to the
+    /// typical sample's.
     #[arg(long)]
     pub icp_covariance: bool,
     /// Return the closed form without maximum-likelihood refinement.
@@ -129,8 +131,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .iter()
         .map(|r| {
             let s = sample_from_record(r);
+            // Without --icp-covariance, `sm_cov` only shapes the residuals' noise level
+            // per sample, as in `calibrate`.
+            let (sm_cov, matcher_cov) = match args.icp_covariance {
+                true => (s.sm_cov, None),
+                false => (None, s.sm_cov),
+            };
             Sample {
-                sm_cov: s.sm_cov.filter(|_| args.icp_covariance),
+                sm_cov,
+                matcher_cov,
                 ..s
             }
         })
@@ -234,6 +243,8 @@ fn summary(args: &Args, cal: &Calibration, total: usize) -> String {
         match cal.noise_source {
             odocal_solver::NoiseSource::Estimated => "these σ",
             odocal_solver::NoiseSource::SampleCovariance => "each sample's sm_cov",
+            odocal_solver::NoiseSource::Shaped =>
+                "these σ shaped by each sample's matcher covariance",
         }
     );
     match &cal.refinement {

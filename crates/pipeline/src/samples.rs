@@ -34,6 +34,7 @@ impl PairSample {
             scan_times: Some([self.pair.t0, self.pair.t1]),
             read_time_sigma: None,
             free_direction: self.icp.free_direction,
+            matcher_cov: Some(self.icp.covariance),
             profile: use_profile.then(|| {
                 self.wheel
                     .profile
@@ -106,6 +107,7 @@ pub fn wheel_only_sample(w: &WheelMotion) -> Sample {
         scan_times: None,
         read_time_sigma: None,
         free_direction: None,
+        matcher_cov: None,
         profile: Some(
             w.profile
                 .iter()

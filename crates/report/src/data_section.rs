@@ -21,7 +21,7 @@ pub(crate) struct Row {
 }
 
 /// The rows, in order. `time_offset_sigma_s` is shown with `time_offset_s`.
-pub(crate) const ROWS: [Row; 27] = [
+pub(crate) const ROWS: [Row; 29] = [
     Row { key: "log_contents", label: "What the input holds", meaning: "scans and wheel records read, lines skipped (lenient mode) and messages not understood" },
     Row { key: "samples_used", label: "Samples used", meaning: "scan pairs with their wheel rotations that entered the final estimate" },
     Row { key: "samples_synchronized", label: "Samples synchronized", meaning: "scan pairs matched and given the wheel rotations between their two scans, before outliers were trimmed" },
@@ -37,6 +37,8 @@ pub(crate) const ROWS: [Row; 27] = [
     Row { key: "interval_s", label: "Pair interval", meaning: "target time (s) between the two scans of a pair" },
     Row { key: "ticks_per_revolution", label: "Encoder ticks per wheel turn", meaning: "wheel counts per revolution (wheel angles of a bag or of odometry are counted in 2²⁰ ticks per turn by convention)" },
     Row { key: "sm_sigma", label: "Scan-matching noise σ", meaning: "standard deviation of one scan match, per component, estimated from the residuals" },
+    Row { key: "noise_weights", label: "Sample weights", meaning: "shaped: the noise σ above, per sample shaped as the scan matcher's covariance of the sample compares with the typical match's (a spin matched through the scans between, a pair sharing few points weigh less); estimated: the same σ for every sample; sample_covariance: each sample's own covariance (--icp-covariance)" },
+    Row { key: "noise_shaping", label: "Sample weights' shaping", meaning: "with shaped weights: the typical match's σ the samples were weighted by; per component, the share of the residuals' noise that follows the matcher's covariances (0: none, 1: as the matcher says); the level the σ of the estimate take with that blend" },
     Row { key: "time_offset_s", label: "Clock offset (laser − encoders)", meaning: "what was subtracted from the laser's timestamps to put them on the wheels' clock, with its σ" },
     Row { key: "cost_before", label: "Cost at the closed form", meaning: "sum of the squared residuals, each in units of its σ (χ²), at the closed-form solution" },
     Row { key: "cost_after", label: "Cost after refinement", meaning: "the same sum after the non-linear refinement (it should not be larger)" },

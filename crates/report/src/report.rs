@@ -8,7 +8,10 @@ use odocal_pipeline::consistency::Consistency;
 use odocal_pipeline::self_check::MatchSelfCheck;
 use odocal_pipeline::sync::DiscardCounts;
 use odocal_pipeline::{Estimate, Finding, FindingKind, Options, Outcome, RejectionCounts, Timing};
-use odocal_solver::{Constraint, LateralSlip, Observability, SharedScanNoise, PARAMETER_NAMES};
+use odocal_solver::{
+    Constraint, LateralSlip, NoiseShaping, NoiseSource, Observability, SharedScanNoise,
+    PARAMETER_NAMES,
+};
 use serde::Serialize;
 use std::fmt;
 use std::path::Path;
@@ -75,6 +78,15 @@ pub struct Report {
     pub ticks_per_revolution: f64,
     /// Estimated scan-matching noise σ (x m, y m, θ rad).
     pub sm_sigma: [f64; 3],
+    /// How the samples were weighted: `shaped` (the noise σ above shaped per sample by
+    /// the matcher's covariance of it, relative to the typical match), `estimated`
+    /// (the σ above for every sample) or `sample_covariance` (`--icp-covariance`).
+    pub noise_weights: NoiseSource,
+    /// With `noise_weights` `shaped`: the typical match's σ the samples were weighted
+    /// by, the share of the residuals' noise that follows the matcher's covariances
+    /// (per component), and the level the σ of the estimate take with that blend.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_shaping: Option<NoiseShaping>,
     /// Weighted cost at the closed form and at the estimate.
     pub cost_before: f64,
     /// Weighted cost at the returned estimate.
@@ -281,6 +293,8 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         interval_s: e.interval_s,
         ticks_per_revolution: outcome.synced.ticks_per_revolution,
         sm_sigma: c.sm_sigma,
+        noise_weights: c.noise_source,
+        noise_shaping: c.noise_shaping,
         cost_before: c.cost_before,
         cost_after: c.cost_after,
         observability: c.observability.clone(),
@@ -512,11 +526,27 @@ impl fmt::Display for Report {
         }
         writeln!(
             f,
-            "  scan-matching noise σ: x {:.3} mm, y {:.3} mm, θ {:.4}°",
+            "  scan-matching noise σ: x {:.3} mm, y {:.3} mm, θ {:.4}°{}",
             self.sm_sigma[0] * 1e3,
             self.sm_sigma[1] * 1e3,
-            self.sm_sigma[2].to_degrees()
+            self.sm_sigma[2].to_degrees(),
+            match self.noise_weights {
+                NoiseSource::Shaped => " (the typical match's)",
+                NoiseSource::Estimated => "",
+                NoiseSource::SampleCovariance => " (each sample weighted by its own covariance)",
+            }
         )?;
+        if let Some(n) = &self.noise_shaping {
+            writeln!(
+                f,
+                "  each sample weighted as the matcher's covariance of it compares with the \
+                 typical match's; the residuals follow it by {:.0} %, {:.0} %, {:.0} % (x, y, θ), \
+                 and the σ take the noise as that blend",
+                100.0 * n.share[0],
+                100.0 * n.share[1],
+                100.0 * n.share[2]
+            )?;
+        }
         if let Some(n) = &self.shared_scan_noise {
             writeln!(
                 f,

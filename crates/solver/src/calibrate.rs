@@ -7,6 +7,7 @@ use crate::error::SolveError;
 use crate::kinematics::{residual_of, Predictor, RawOdometry};
 use crate::matcher_bias::bias_covariance;
 use crate::noise::{residual_sigmas, NoiseWeights};
+use crate::noise_shape::{independent_score, NoiseShapes, NoiseShaping};
 use crate::observability::{
     full_sentence, information_not_excited, judged, null_direction_names, step1_not_excited,
     step2_not_excited, wheel_signs, MotionContent, Observability, Verdict,
@@ -123,6 +124,10 @@ pub enum NoiseSource {
     Estimated,
     /// Each sample's own `sm_cov`.
     SampleCovariance,
+    /// Standard deviations estimated from the residuals, shaped per sample by the
+    /// scan matcher's covariance of it relative to the typical match
+    /// ([`Sample::matcher_cov`]).
+    Shaped,
 }
 
 /// The closed-form solution on one set of samples.
@@ -170,6 +175,9 @@ pub struct Calibration {
     pub refinement: Option<Refinement>,
     /// Observability report.
     pub observability: Observability,
+    /// With the samples weighted by the matcher's shapes ([`NoiseSource::Shaped`]):
+    /// the levels and the share of the noise that follows the shapes.
+    pub noise_shaping: Option<NoiseShaping>,
     /// The noise shared by samples that share a scan, when the samples carry their
     /// scans' times (the covariance then accounts for it); `None`: the samples
     /// were treated as independent.
@@ -492,11 +500,6 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         SigmaEstimate::FinalSet => residual_sigmas(&scratch.residuals),
     };
 
-    let (weights, noise_source) = match sample_weights {
-        Some(w) => (w, NoiseSource::SampleCovariance),
-        None => (NoiseWeights::from_sigmas(sm_sigma), NoiseSource::Estimated),
-    };
-    let weights = weights.with_free_directions(samples);
     // The samples that leave a direction free join for the refinement, unless their
     // residual in the directions they fix is an outlier at the closed form.
     active.extend(free_kept(
@@ -506,6 +509,27 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         options.trim,
     ));
     active.sort_unstable_by_key(|p| p.index);
+    // Without weights of their own, the residuals' level shaped per sample by the
+    // matcher's covariance of it, when the samples carry one (the samples used give
+    // the typical match).
+    let shapes = match sample_weights {
+        Some(_) => None,
+        None => NoiseShapes::of(samples, &active),
+    };
+    let weight_level = shapes
+        .as_ref()
+        .map(|m| m.level(&active, &residuals_at(&active, &cf.params), [1.0; 3]));
+    let shaped = shapes
+        .as_ref()
+        .zip(weight_level)
+        .and_then(|(m, level)| m.information(level));
+    let (weights, noise_source) = match (sample_weights, shaped) {
+        (Some(w), _) => (w, NoiseSource::SampleCovariance),
+        (None, Some(info)) => (NoiseWeights::PerSample(info), NoiseSource::Shaped),
+        (None, None) => (NoiseWeights::from_sigmas(sm_sigma), NoiseSource::Estimated),
+    };
+    let shapes = shapes.filter(|_| noise_source == NoiseSource::Shaped);
+    let weights = weights.with_free_directions(samples);
 
     // The last pass of the refinement (or one pass at the closed form) gives the
     // cost and the Fisher information at the estimate.
@@ -525,14 +549,38 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // Motion classes with the estimated radii; for the "not excited" errors, where
     // the estimate is not trustworthy, with equal radii.
     let motion_equal_radii = || MotionContent::classify(&active, 1.0, 1.0);
+    // The covariance takes the noise as the blend of the level and the shapes that
+    // the residuals support (`crate::noise_shape`).
+    let noise_shaping = shapes.as_ref().zip(weight_level).map(|(m, weight_level)| {
+        let residuals = residuals_at(&active, &params);
+        let share = m.share_followed(&active, &residuals);
+        NoiseShaping {
+            weight_level,
+            share,
+            level: m.level(&active, &residuals, share),
+        }
+    });
+    let noise_maps = shapes
+        .as_ref()
+        .zip(noise_shaping)
+        .map(|(m, n)| m.maps(n.level, n.share));
     let (covariance, shared_scan_noise, inverse) = match invert_information(&information) {
         Inversion::Covariance(c) => {
             let inverse = zero_held_rows(*c, &constraints);
             let bias = bias_covariance(&active, &params, &weights, &inverse, options.matcher_bias);
-            let (random, model) = match score_covariance(&active, &params, &weights, &inverse) {
-                Some((score, model)) => (sandwich(&inverse, &score, &constraints), Some(model)),
-                None => (inverse, None),
-            };
+            let (random, model) =
+                match score_covariance(&active, &params, &weights, &inverse, noise_maps.as_deref())
+                {
+                    Some((score, model)) => (sandwich(&inverse, &score, &constraints), Some(model)),
+                    None => match noise_maps.as_deref().zip(noise_shaping) {
+                        Some((maps, n)) => {
+                            let score =
+                                independent_score(&active, &params, &weights, maps, n.level);
+                            (sandwich(&inverse, &score, &constraints), None)
+                        }
+                        None => (inverse, None),
+                    },
+                };
             (
                 std::array::from_fn(|i| std::array::from_fn(|j| random[i][j] + bias[i][j])),
                 model,
@@ -593,6 +641,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
         refinement,
         observability,
         shared_scan_noise,
+        noise_shaping,
         lateral_slip: None,
     })
 }

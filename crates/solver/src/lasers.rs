@@ -9,19 +9,19 @@
 //! (when its samples carry scan times) in the sandwich, as the single-laser solve does.
 //! Lasers never share a scan, so their scores are independent.
 
-use crate::calibrate::{calibrate, Calibration, NoiseSource, SolveOptions};
+use crate::calibrate::{calibrate, Calibration, SolveOptions};
 use crate::constraints::{Constraint, Constraints};
 use crate::damping::Damping;
 use crate::error::SolveError;
 use crate::kinematics::{residual_of, Predictor};
-use crate::linalg::information_from_covariance;
-use crate::noise::{NoiseWeights, SIGMA_FLOOR};
+use crate::noise::NoiseWeights;
+use crate::noise_shape::{shapes_used, weights_used};
 use crate::observability::{parameter_reports, sentence, wheel_signs};
 use crate::packed::Packed;
 use crate::params::Params;
 use crate::sample::Sample;
 use crate::shared_scans::score_covariance;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::{DMatrix, DVector, Matrix3};
 use odocal_geom::{wrap_angle, Pose2};
 use serde::Serialize;
 
@@ -127,27 +127,9 @@ pub(crate) fn relative_pose(a: &Pose2, b: &Pose2) -> (Pose2, DMatrix<f64>) {
 struct Group<'a> {
     packed: Vec<Packed<'a>>,
     weights: NoiseWeights,
-}
-
-/// The weights laser `own`'s solve used, for its `samples`.
-fn weights_of(own: &Calibration, samples: &[Sample]) -> NoiseWeights {
-    match own.noise_source {
-        NoiseSource::SampleCovariance => NoiseWeights::PerSample(
-            samples
-                .iter()
-                .map(|s| {
-                    s.sm_cov
-                        .as_ref()
-                        .and_then(information_from_covariance)
-                        .unwrap_or([[0.0; 3]; 3])
-                })
-                .collect(),
-        ),
-        NoiseSource::Estimated => {
-            NoiseWeights::Shared(own.sm_sigma.map(|s| 1.0 / s.max(SIGMA_FLOOR).powi(2)))
-        }
-    }
-    .with_free_directions(samples)
+    /// Each sample's noise map for the covariance (`crate::noise_shape`), when the
+    /// laser's own solve weighted by the matcher's shapes.
+    maps: Option<Vec<Matrix3<f64>>>,
 }
 
 /// `(cost, H, g)` of the joint fit at `params`.
@@ -320,12 +302,19 @@ pub fn calibrate_lasers_constrained(
     let groups: Vec<Group> = own
         .iter()
         .zip(&own_samples)
-        .map(|(c, group)| Group {
-            packed: Packed::all(group, options.use_profile)
+        .map(|(c, group)| {
+            let packed: Vec<Packed> = Packed::all(group, options.use_profile)
                 .into_iter()
                 .filter(|p| c.used[p.index])
-                .collect(),
-            weights: weights_of(c, group),
+                .collect();
+            let shapes = shapes_used(c, group);
+            Group {
+                weights: weights_used(c, group, shapes.as_ref()),
+                packed,
+                maps: shapes
+                    .zip(c.noise_shaping)
+                    .map(|(m, n)| m.maps(n.level, n.share)),
+            }
         })
         .collect();
 
@@ -512,7 +501,13 @@ fn sandwich(
         let p = Params::from_vector(ix.map(|i| params[i]));
         let h_inv: [[f64; 6]; 6] =
             std::array::from_fn(|i| std::array::from_fn(|j| inverse[(ix[i], ix[j])]));
-        match score_covariance(&group.packed, &p, &group.weights, &h_inv) {
+        match score_covariance(
+            &group.packed,
+            &p,
+            &group.weights,
+            &h_inv,
+            group.maps.as_deref(),
+        ) {
             Some((score, _)) => {
                 any_shared = true;
                 for a in 0..6 {

@@ -14,6 +14,7 @@ use crate::damping::Damping;
 use crate::kinematics::residual_of;
 use crate::linalg::unit_diagonal;
 use crate::noise::NoiseWeights;
+use crate::noise_shape::{shapes_used, weights_used};
 use crate::normal_equations::NormalEquations;
 use crate::observability::wheel_signs;
 use crate::params::Params;
@@ -255,9 +256,8 @@ pub fn fit_lateral_slip(
     let used: Vec<usize> = (0..samples.len())
         .filter(|&i| calibration.used.get(i).copied().unwrap_or(false))
         .collect();
-    let weights = NoiseWeights::from_samples(samples)
-        .unwrap_or_else(|| NoiseWeights::from_sigmas(calibration.sm_sigma))
-        .with_free_directions(samples);
+    let shapes = shapes_used(calibration, samples);
+    let weights = weights_used(calibration, samples, shapes.as_ref());
     let constraints = &options.constraints;
     let use_profile = options.use_profile;
     let start = calibration.params.to_vector();

@@ -59,6 +59,7 @@ mod lateral_slip;
 mod linalg;
 mod matcher_bias;
 mod noise;
+mod noise_shape;
 mod normal_equations;
 mod observability;
 mod one_sample;
@@ -90,6 +91,7 @@ pub use lasers::{
 };
 pub use lateral_slip::{fit_lateral_slip, LateralSlip, SlideFit};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
+pub use noise_shape::{NoiseShaping, MIN_SHAPED_SAMPLES};
 pub use observability::{
     MotionContent, Observability, ParameterReport, Verdict, MOTION_CLASS_RATIO,
     PARTIAL_CALIBRATION_HINT,

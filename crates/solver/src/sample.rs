@@ -51,6 +51,13 @@ pub struct Sample {
     /// limit of a covariance infinitely wide along it, whatever the noise model.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub free_direction: Option<[f64; 3]>,
+    /// The scan matcher's covariance of `ŝ` when it is not the noise the samples
+    /// are weighted by (`sm_cov` absent): only its shape and its size relative to
+    /// the other samples' count. The residuals give the noise's level; each sample
+    /// is weighted by that level shaped as the matcher's covariance of it says
+    /// (see [`crate::calibrate`]). `None`: the residuals' level alone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub matcher_cov: Option<[[f64; 3]; 3]>,
 }
 
 /// `e` without its component along `free` (orthogonal projection in `(x, y, θ)`;
@@ -81,6 +88,7 @@ impl Sample {
             scan_times: None,
             read_time_sigma: None,
             free_direction: None,
+            matcher_cov: None,
         }
     }
 
@@ -105,6 +113,7 @@ impl Sample {
             scan_times: None,
             read_time_sigma: None,
             free_direction: None,
+            matcher_cov: None,
         }
     }
 

@@ -209,12 +209,16 @@ fn read_time_parts(s: &Packed, pred: &Predictor) -> Option<[Vector3<f64>; 2]> {
 /// `Var(Σ GᵀWe)` at `params` under the shared-scan model, with the model; `None`
 /// when some sample has no scan times or fewer than [`MIN_SHARED_SCANS`] scans
 /// are shared (then the samples count as independent). `h_inv` is the inverse
-/// information of the fit (held parameters' rows zero).
+/// information of the fit (held parameters' rows zero). With `shapes` (per sample
+/// index, the map `M_k` from a noise of one level to the sample's own; see
+/// `crate::noise_shape`) the model is estimated on the residuals whitened by
+/// `M_k⁻¹`, and its score mapped back by `M_k`.
 pub(crate) fn score_covariance(
     samples: &[Packed],
     params: &Params,
     weights: &NoiseWeights,
     h_inv: &[[f64; 6]; 6],
+    shapes: Option<&[Matrix3<f64>]>,
 ) -> Option<([[f64; 6]; 6], SharedScanNoise)> {
     let times: Vec<[f64; 2]> = samples
         .iter()
@@ -233,16 +237,29 @@ pub(crate) fn score_covariance(
             .collect(),
         read_time: samples.iter().map(|s| read_time_parts(s, &pred)).collect(),
     };
-    for s in samples {
+    for (k, s) in samples.iter().enumerate() {
         let (pr, jac) = pred.predict_with_jacobian_pieces(s.pieces());
         let gk = Matrix3x6::from_fn(|i, j| jac[i][j]);
         // A free direction's residual is no scan's error (`Sample::free_direction`).
-        p.e.push(Vector3::from(measured_part(
-            residual_of(pr, &s.sm),
-            s.free_direction,
-        )));
-        p.gw.push(gk.transpose() * weight(weights, s.index));
-        p.g.push(gk);
+        let e = Vector3::from(measured_part(residual_of(pr, &s.sm), s.free_direction));
+        let gw = gk.transpose() * weight(weights, s.index);
+        // Whitened to one level: e = M ẽ, G = M G̃, GᵀW = G̃ᵀW̃ M⁻¹ with W̃ = MᵀWM.
+        let shape = shapes.and_then(|m| m.get(s.index));
+        match shape.and_then(|m| Some((m, m.try_inverse()?))) {
+            Some((m, m_inv)) => {
+                p.e.push(m_inv * e);
+                p.gw.push(gw * m);
+                p.g.push(m_inv * gk);
+                if let Some(rt) = p.read_time.as_mut() {
+                    rt[k] = rt[k].map(|part| m_inv * part);
+                }
+            }
+            None => {
+                p.e.push(e);
+                p.gw.push(gw);
+                p.g.push(gk);
+            }
+        }
     }
     let (d, shared) = per_scan_covariance(samples, &times, &p.e, p.read_time.as_deref())?;
     // The D part: Σ_j U_j D U_jᵀ, U_j summing GᵀWA and GᵀWB over the samples that
