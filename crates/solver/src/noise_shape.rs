@@ -3,29 +3,32 @@
 //! The residuals measure the noise's level, one per component (x, y, θ); they
 //! cannot tell which samples are the noisy ones. The matcher can: its covariance
 //! of `ŝ` is large for a spin matched through intermediate scans, for a pair that
-//! shares few points, along a corridor. Each sample's noise is taken as the
-//! residuals' level shaped by the matcher's covariance relative to the log's typical
-//! match, `Σ_k = M_k Σ̄ M_kᵀ` with `Σ̄ = diag(sm_sigma²)` and
-//! `M_k = diag(σ) L_k diag(1/σ)`, `L_k L_kᵀ` the matcher's covariance divided, per
-//! component, by its median over the samples. The samples are weighted by `Σ_k⁻¹`.
+//! shares few points. Each sample's noise is taken as the typical match's level
+//! shaped by the matcher's covariance relative to the typical match's,
+//! `Σ_k = M_k Σ̄ M_kᵀ` with `Σ̄ = diag(σ²)` and `M_k = diag(σ) L_k diag(1/σ)`,
+//! `L_k L_kᵀ` the matcher's covariance divided, per component, by its median over
+//! the samples used; `σ` is measured on the residuals divided by their shapes
+//! ([`NoiseShaping::weight_level`]). The samples are weighted by `Σ_k⁻¹`.
 //!
 //! Weighted so, the simulated realistic presets (30 logs × 120 s each) calibrate
-//! 1.1–2.3× nearer the truth than with one level for all (ℓx on the TurtleBot 4,
-//! 1.19 → 0.63 mm RMS; the Neato's b, 2.2 → 1.3 mm; the rover's ℓθ, 2.8 → 1.3
+//! 1.1–2.2× nearer the truth than with one level for all (ℓx on the TurtleBot 4,
+//! 1.19 → 0.67 mm RMS; the Neato's b, 2.25 → 1.58 mm; the rover's ℓθ, 2.83 → 1.26
 //! mrad), and a short log's few spins, which the matcher finds 3–5× noisier than
 //! its straights, no longer decide the laser's offsets alone.
 //!
 //! The matcher's covariance predicts the residuals only in part: the wheels' own
 //! noise is the same for every sample, and a match can be off more or less than it
-//! says. How far it predicts them is measured on the log: per component, the
-//! squared residuals regressed on the matcher's relative variances give the share
-//! `w` of the noise that follows them (`E[e²] ∝ (1 − w) + w·g`; 0.1–0.6 on the
-//! simulated realistic presets). The covariance of the estimate takes the noise as
-//! that blend, `R̃_k = (I − W) + W^½ R_k W^½`: the shared-scan model
+//! says. How far it predicts them is measured on the log, per component: the share
+//! `w` for which the squared residuals over `(1 − w) + w·g` (`g` the relative
+//! variance) have the same median among the samples the matcher finds noisiest as
+//! among the quietest ([`NoiseShapes::share_followed`]; 10–90 % on the simulated
+//! presets and the real MinesRover logs). The covariance of the estimate takes the
+//! noise as that blend, `R̃_k = (I − W) + W^½ R_k W^½`: the shared-scan model
 //! (`crate::shared_scans`) is estimated on the residuals whitened by its map
 //! `M̃_k⁻¹`, where one level holds, and its score mapped back by `M̃_k`. Weighting
 //! by the matcher's full shapes is what makes the estimate precise; taking them at
-//! their word in its covariance would make it overconfident.
+//! their word in its covariance would make it overconfident (the TurtleBot 4's ℓθ
+//! at 1.35 RMS error/σ).
 
 use crate::calibrate::{Calibration, NoiseSource};
 use crate::kinematics::Predictor;
@@ -90,13 +93,13 @@ impl NoiseShapes {
         })
     }
 
-    /// Per sample, the map `M_k = diag(σ) L_k diag(1/σ)` from a noise of the level
-    /// `sm_sigma` (σ) to the sample's own, `L_k L_kᵀ` its shape blended with the level
+    /// Per sample, the map `M_k = diag(σ) L_k diag(1/σ)` from a noise of the typical
+    /// match's `level` (σ) to the sample's own, `L_k L_kᵀ` its shape blended with the level
     /// by `share` per component: `(I − W) + W^½ R_k W^½`, `W = diag(share)` (1: the
     /// matcher's shapes as they are). The identity for a sample without a shape or
     /// whose blend is not positive definite.
-    pub(crate) fn maps(&self, sm_sigma: [f64; 3], share: [f64; 3]) -> Vec<Matrix3<f64>> {
-        let sigma = Vector3::from(sm_sigma);
+    pub(crate) fn maps(&self, level: [f64; 3], share: [f64; 3]) -> Vec<Matrix3<f64>> {
+        let sigma = Vector3::from(level);
         let to_level = Matrix3::from_diagonal(&sigma);
         let from_level = Matrix3::from_diagonal(&sigma.map(|s| 1.0 / s));
         let share = Vector3::from(share.map(|w| w.clamp(0.0, 1.0)));
@@ -112,17 +115,17 @@ impl NoiseShapes {
     }
 
     /// The information `(M_k Σ̄ M_kᵀ)⁻¹` of each sample's noise under the matcher's
-    /// full shapes, `Σ̄ = diag(sm_sigma²)`; `None` when `sm_sigma` has a component that
-    /// is not positive or some noise is singular.
-    pub(crate) fn information(&self, sm_sigma: [f64; 3]) -> Option<Vec<[[f64; 3]; 3]>> {
-        if sm_sigma.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+    /// full shapes, `Σ̄ = diag(level²)` (the typical match's σ); `None` when `level` has
+    /// a component that is not positive or some noise is singular.
+    pub(crate) fn information(&self, level: [f64; 3]) -> Option<Vec<[[f64; 3]; 3]>> {
+        if level.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
             return None;
         }
-        let level = Matrix3::from_diagonal(&Vector3::from(sm_sigma.map(|s| s * s)));
-        self.maps(sm_sigma, [1.0; 3])
+        let typical = Matrix3::from_diagonal(&Vector3::from(level.map(|s| s * s)));
+        self.maps(level, [1.0; 3])
             .iter()
             .map(|m| {
-                let info = (m * level * m.transpose()).try_inverse()?;
+                let info = (m * typical * m.transpose()).try_inverse()?;
                 let info = 0.5 * (info + info.transpose());
                 Some(std::array::from_fn(|r| {
                     std::array::from_fn(|c| info[(r, c)])
