@@ -12,6 +12,39 @@ fn is_separator(b: u8) -> bool {
     matches!(b, b' ' | b'\t' | b'\n' | b'\r' | 0x0b | 0x0c)
 }
 
+/// The common token of [`Tokens::next_decimal`] in one tight pass: from `body` (after
+/// any sign), `digits[.digits]` with 1 to 19 digits in all, ending at a separator or
+/// the line's end. Returns the token's end, its mantissa and its digits after the point
+/// — what the general loop finds for such a token; `None` for any other token, which
+/// the general loop reads instead.
+#[inline]
+fn plain_body(s: &[u8], body: usize) -> Option<(usize, u64, usize)> {
+    let mut i = body;
+    let mut m = 0u64;
+    let mut digits = digit_run(s, &mut i, &mut m);
+    let mut after_point = 0;
+    if s.get(i) == Some(&b'.') {
+        i += 1;
+        after_point = digit_run(s, &mut i, &mut m);
+        digits += after_point;
+    }
+    let ends = s.get(i).is_none_or(|&c| is_separator(c));
+    (ends && (1..=19).contains(&digits)).then_some((i, m, after_point))
+}
+
+/// Moves `i` past the decimal digits of `s` from `i`, appending them to `m`; returns
+/// how many there were. Wrapping: a token of more than 19 digits is refused by
+/// [`plain_body`] whatever `m` became.
+#[inline]
+fn digit_run(s: &[u8], i: &mut usize, m: &mut u64) -> usize {
+    let from = *i;
+    while let Some(d) = s.get(*i).map(|c| c.wrapping_sub(b'0')).filter(|&d| d <= 9) {
+        *m = m.wrapping_mul(10).wrapping_add(u64::from(d));
+        *i += 1;
+    }
+    *i - from
+}
+
 /// The whitespace-separated tokens of one line.
 #[derive(Clone)]
 pub(crate) struct Tokens<'a> {
@@ -37,6 +70,10 @@ impl<'a> Tokens<'a> {
             i += 1;
         }
         let body = i;
+        if let Some((end, m, k)) = plain_body(s, body) {
+            self.i = end;
+            return Some((&s[start..end], Some((neg, m, k))));
+        }
         let (mut m, mut digits, mut frac, mut plain) = (0u64, 0usize, None, true);
         while i < s.len() && !is_separator(s[i]) {
             let c = s[i];
