@@ -53,7 +53,8 @@ const MIN_SIGMA: f64 = 1e-3;
 
 /// `mixed[i]`: reading `i` is a mixed pixel (see the module documentation), judged
 /// with `sigma` the scan's range noise (m; at least [`MIN_SIGMA`]). Readings are valid
-/// when finite, above `lo` and below `hi`; `angles` in rad. All false when the noise
+/// when finite, above `lo` and below `hi`; `angles` in rad, `directions` their
+/// `(cos, sin)` when the caller has them (one per angle). All false when the noise
 /// is unknown (`None`, or NaN), `params.mixed_pixel_sigmas` is infinite, or the rays
 /// are more than [`MAX_RAY_STEP`] apart on average.
 ///
@@ -65,6 +66,7 @@ const MIN_SIGMA: f64 = 1e-3;
 pub(crate) fn mixed_pixel_readings(
     ranges: &[f32],
     angles: &[f64],
+    directions: Option<&[[f64; 2]]>,
     lo: f64,
     hi: f64,
     sigma: Option<f64>,
@@ -115,7 +117,10 @@ pub(crate) fn mixed_pixel_readings(
             continue;
         };
         let point = |k: usize, r: f64| {
-            let (sin, cos) = angles[k].sin_cos();
+            let (sin, cos) = match directions {
+                Some(d) => (d[k][1], d[k][0]),
+                None => angles[k].sin_cos(),
+            };
             [r * cos, r * sin]
         };
         let p = point(i, r);
@@ -250,7 +255,7 @@ mod tests {
         sigma: Option<f64>,
         params: &IcpParams,
     ) -> Vec<usize> {
-        let mixed = mixed_pixel_readings(ranges, angles, 0.02, 5.6, sigma, params);
+        let mixed = mixed_pixel_readings(ranges, angles, None, 0.02, 5.6, sigma, params);
         (0..ranges.len()).filter(|&i| mixed[i]).collect()
     }
 

@@ -30,7 +30,7 @@
 //! own scans cannot be prepared is left refused.
 
 use crate::chained::{congruence, LinkSource};
-use crate::matching::{prepare_scan, MatchStats};
+use crate::matching::{prepare_scan, store_rays, MatchStats};
 use crate::rejection::{MatchFailure, Rejection};
 use crate::sweep::compensate_into;
 use odocal_icp::{IcpParams, IcpResult, Matcher, PreparedScan};
@@ -146,9 +146,10 @@ fn prepare_all(
 ) -> HashMap<usize, PreparedScan> {
     let unique: BTreeSet<usize> = indices.collect();
     let unique: Vec<usize> = unique.into_iter().collect();
+    let rays = store_rays(scans);
     unique
         .par_iter()
-        .filter_map(|&i| Some((i, prepare_scan(scans, i, params)?.ok()?)))
+        .filter_map(|&i| Some((i, prepare_scan(scans, &rays, i, params)?.ok()?)))
         .collect::<Vec<_>>()
         .into_iter()
         .collect()

@@ -3,7 +3,7 @@
 use crate::parallel::match_chain;
 use crate::rejection::{MatchFailure, Rejection};
 use odocal_geom::Pose2;
-use odocal_icp::{IcpParams, Matcher, PreparedScan};
+use odocal_icp::{IcpParams, Matcher, PreparedScan, RayDirections};
 use odocal_log::ScanStore;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -102,21 +102,32 @@ pub fn scan_returns(scans: &ScanStore) -> Option<ScanReturns> {
     })
 }
 
-/// Scan `i` of `scans` prepared for matching with `params`; `None` when the store has
-/// no scan `i`.
+/// The ray directions of each of the store's geometries (indexed as
+/// [`ScanStore::geometries`]), for [`prepare_scan`].
+pub(crate) fn store_rays(scans: &ScanStore) -> Vec<RayDirections> {
+    scans
+        .geometries
+        .iter()
+        .map(|g| RayDirections::new(&g.angles))
+        .collect()
+}
+
+/// Scan `i` of `scans` prepared for matching with `params`, along the rays of its
+/// geometry in `rays` ([`store_rays`] of `scans`); `None` when the store has no scan
+/// `i`.
 pub(crate) fn prepare_scan(
     scans: &ScanStore,
+    rays: &[RayDirections],
     i: usize,
     params: &IcpParams,
 ) -> Option<Result<PreparedScan, odocal_icp::IcpError>> {
     let s = scans.get(i)?;
-    Some(PreparedScan::new(
-        s.ranges,
-        &s.geometry.angles,
-        s.geometry.min_range,
-        s.geometry.max_range,
-        params,
-    ))
+    let (min_range, max_range) = (s.geometry.min_range, s.geometry.max_range);
+    let geometry = scans.scans.get(i)?.geometry as usize;
+    Some(match rays.get(geometry) {
+        Some(r) => PreparedScan::with_rays(s.ranges, r, min_range, max_range, params),
+        None => PreparedScan::new(s.ranges, &s.geometry.angles, min_range, max_range, params),
+    })
 }
 
 /// The median range noise (σ, m) of up to [`NOISE_SAMPLE_SCANS`] scans spread evenly
@@ -126,10 +137,11 @@ pub(crate) fn prepare_scan(
 pub fn typical_noise_sigma(scans: &ScanStore, params: &IcpParams) -> f64 {
     let every = (scans.len() / NOISE_SAMPLE_SCANS).max(1);
     let sampled: Vec<usize> = (0..scans.len()).step_by(every).collect();
+    let rays = store_rays(scans);
     // On the current pool's threads; collected in scan order.
     let mut noise: Vec<f64> = sampled
         .into_par_iter()
-        .filter_map(|i| prepare_scan(scans, i, params)?.ok()?.noise_sigma())
+        .filter_map(|i| prepare_scan(scans, &rays, i, params)?.ok()?.noise_sigma())
         .collect();
     if noise.is_empty() {
         return 0.0;
@@ -187,7 +199,8 @@ pub fn match_pairs(
         own_params = with_typical_noise(params, typical_noise_sigma(scans, params));
         params = &own_params;
     }
-    let prepare = |i: usize| match prepare_scan(scans, i, params) {
+    let rays = store_rays(scans);
+    let prepare = |i: usize| match prepare_scan(scans, &rays, i, params) {
         Some(Ok(scan)) => Ok(scan),
         Some(Err(e)) => {
             let place = scans.get(i).map(|s| scan_place(&s)).unwrap_or_default();
