@@ -78,9 +78,10 @@ pub struct Report {
     pub ticks_per_revolution: f64,
     /// Estimated scan-matching noise σ (x m, y m, θ rad).
     pub sm_sigma: [f64; 3],
-    /// How the samples were weighted: `shaped` (the noise σ above shaped per sample by
-    /// the matcher's covariance of it, relative to the typical match), `estimated`
-    /// (the σ above for every sample) or `sample_covariance` (`--icp-covariance`).
+    /// How the samples were weighted: `shaped` (the typical match's σ,
+    /// `noise_shaping.weight_level`, shaped per sample by the matcher's covariance of
+    /// it relative to the typical match's), `estimated` (`sm_sigma` for every sample)
+    /// or `sample_covariance` (`--icp-covariance`).
     pub noise_weights: NoiseSource,
     /// With `noise_weights` `shaped`: the typical match's σ the samples were weighted
     /// by, the share of the residuals' noise that follows the matcher's covariances
@@ -531,17 +532,20 @@ impl fmt::Display for Report {
             self.sm_sigma[1] * 1e3,
             self.sm_sigma[2].to_degrees(),
             match self.noise_weights {
-                NoiseSource::Shaped => " (the typical match's)",
-                NoiseSource::Estimated => "",
+                NoiseSource::Shaped | NoiseSource::Estimated => "",
                 NoiseSource::SampleCovariance => " (each sample weighted by its own covariance)",
             }
         )?;
         if let Some(n) = &self.noise_shaping {
             writeln!(
                 f,
-                "  each sample weighted as the matcher's covariance of it compares with the \
-                 typical match's; the residuals follow it by {:.0} %, {:.0} %, {:.0} % (x, y, θ), \
-                 and the σ take the noise as that blend",
+                "  each sample weighted by the typical match's σ (x {:.3} mm, y {:.3} mm, θ \
+                 {:.4}°) shaped as the matcher's covariance of it compares with the typical \
+                 match's; the residuals follow it by {:.0} %, {:.0} %, {:.0} % (x, y, θ), and \
+                 the σ take the noise as that blend",
+                n.weight_level[0] * 1e3,
+                n.weight_level[1] * 1e3,
+                n.weight_level[2].to_degrees(),
                 100.0 * n.share[0],
                 100.0 * n.share[1],
                 100.0 * n.share[2]

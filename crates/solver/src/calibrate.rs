@@ -562,8 +562,8 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     });
     let noise_maps = shapes
         .as_ref()
-        .zip(noise_shaping)
-        .map(|(m, n)| m.maps(n.level, n.share));
+        .zip(noise_shaping.as_ref())
+        .map(|(m, n)| m.covariance_maps(n));
     let (covariance, shared_scan_noise, inverse) = match invert_information(&information) {
         Inversion::Covariance(c) => {
             let inverse = zero_held_rows(*c, &constraints);

@@ -312,8 +312,8 @@ pub fn calibrate_lasers_constrained(
                 weights: weights_used(c, group, shapes.as_ref()),
                 packed,
                 maps: shapes
-                    .zip(c.noise_shaping)
-                    .map(|(m, n)| m.maps(n.level, n.share)),
+                    .zip(c.noise_shaping.as_ref())
+                    .map(|(m, n)| m.covariance_maps(n)),
             }
         })
         .collect();

@@ -114,6 +114,12 @@ impl NoiseShapes {
             .collect()
     }
 
+    /// The maps the covariance of an estimate takes each sample's noise through
+    /// ([`NoiseShapes::maps`] at the blend `shaping` measured).
+    pub(crate) fn covariance_maps(&self, shaping: &NoiseShaping) -> Vec<Matrix3<f64>> {
+        self.maps(shaping.level, shaping.share)
+    }
+
     /// The information `(M_k Σ̄ M_kᵀ)⁻¹` of each sample's noise under the matcher's
     /// full shapes, `Σ̄ = diag(level²)` (the typical match's σ); `None` when `level` has
     /// a component that is not positive or some noise is singular.
