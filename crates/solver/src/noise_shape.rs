@@ -32,7 +32,6 @@
 
 use crate::calibrate::{Calibration, NoiseSource};
 use crate::kinematics::Predictor;
-use crate::linalg::information_from_covariance;
 use crate::noise::NoiseWeights;
 use crate::packed::Packed;
 use crate::params::Params;
@@ -295,17 +294,10 @@ pub(crate) fn weights_used(
         .zip(calibration.noise_shaping)
         .and_then(|(m, n)| m.information(n.weight_level));
     match (calibration.noise_source, shaped) {
-        (NoiseSource::SampleCovariance, _) => NoiseWeights::PerSample(
-            samples
-                .iter()
-                .map(|s| {
-                    s.sm_cov
-                        .as_ref()
-                        .and_then(information_from_covariance)
-                        .unwrap_or([[0.0; 3]; 3])
-                })
-                .collect(),
-        ),
+        // Every sample carried a covariance, or the solve would not have used them.
+        (NoiseSource::SampleCovariance, _) => {
+            NoiseWeights::from_samples(samples).unwrap_or_else(|| NoiseWeights::from_sigmas(sigma))
+        }
         (NoiseSource::Shaped, Some(info)) => NoiseWeights::PerSample(info),
         (NoiseSource::Estimated | NoiseSource::Shaped, _) => NoiseWeights::from_sigmas(sigma),
     }
