@@ -663,7 +663,8 @@ pub fn calibrate_log(
         .map_err(|e| PipelineError::with_faults(e, &findings))?;
     synced.read_time_sigma = read_time_sigma;
     if let Some(j) =
-        health::scan_jitter::estimate(&log.scans.scans, &log.encoders).filter(|j| j.detected())
+        health::scan_jitter::estimate(&log.scans.scans, &log.encoders, opts.time_offset)
+            .filter(|j| j.detected())
     {
         findings.push(j.finding());
         synced.unrepaired_timing = Some(j.cause());

@@ -5,8 +5,11 @@
 //! variance. Each sample then pairs the scans' motion with the wheels' over a wrong
 //! interval; nothing repairs it, so the verdicts cannot be "well determined" (see
 //! [`crate::run`]). Scans stamped with the very times of the encoder records (one
-//! clock read for both) share the error and are left alone.
+//! clock read for both) share the error and are left alone, also when every encoder
+//! stamp is moved by one constant (an encoder clock set apart: the clock offset,
+//! which is estimated, not the laser's timing).
 
+use super::clock_offset::QUICK_RANGE_S;
 use crate::finding::{Finding, FindingKind};
 use odocal_log::{EncoderRecord, ScanMeta};
 
@@ -36,46 +39,119 @@ pub(crate) fn median(mut v: Vec<f64>) -> Option<f64> {
     Some(*m)
 }
 
-/// True when most scans carry exactly the timestamp of an encoder record, among the
-/// scans the encoder stream covers (an encoder record within [`GAP_RATIO`] of its
-/// median spacing): a gap in the wheel counts says nothing about the scans' stamps (on
-/// the real MinesRover exp1 with 63 s of ENCODER records removed, the scans of the gap
-/// were otherwise taken for stamps of their own, and the finding fired at 12.3 ms).
-fn shares_encoder_stamps(scans: &[ScanMeta], encoders: &[EncoderRecord]) -> bool {
-    let times: Vec<f64> = encoders.iter().map(|e| e.t).collect();
+/// Two timestamps this close (s) are one clock read: a microsecond, far below any
+/// jitter that matters, and above the rounding of stamps written to the microsecond
+/// and moved by a constant (doubles are 2.4e-7 s apart at Unix-epoch magnitudes).
+const SAME_STAMP_S: f64 = 1e-6;
+/// Scans whose differences to the encoder stamps propose the shared offset.
+const OFFSET_SAMPLES: usize = 200;
+/// Offsets tried, the differences most scans of the sample share.
+const CANDIDATES: usize = 3;
+
+/// The offset (s, laser clock minus encoder clock) at which most scans carry exactly
+/// the timestamp of an encoder record moved by that one constant, among the scans the
+/// encoder stream covers there (an encoder record within [`GAP_RATIO`] of its median
+/// spacing); `None` when there is none. Searched within ±[`QUICK_RANGE_S`] of
+/// `center` (the offset in use), the range of the quick clock-offset check.
+///
+/// Only the differences between laser and encoder stamps count, so an encoder clock
+/// set apart by a constant leaves the answer as it is (on the real MinesRover exp1
+/// with every ENCODER record moved by +0.5 s, when only an offset of zero was
+/// tried, the scans were taken for stamps of their own and the finding fired at
+/// 12.3 ms, as it did not on the log as recorded). A gap in the wheel counts says
+/// nothing about the scans' stamps (on exp1 with 63 s of ENCODER records removed, the
+/// scans of the gap were otherwise taken for stamps of their own, and the finding
+/// fired at 12.3 ms).
+///
+/// The offsets tried are the differences between a scan's and an encoder record's
+/// stamp that most of a sample of scans share (a shared clock read gives one
+/// difference for nearly every scan; stamps of their own, differences all apart).
+fn shared_stamp_offset(scans: &[ScanMeta], encoders: &[EncoderRecord], center: f64) -> Option<f64> {
+    let mut times: Vec<f64> = encoders.iter().map(|e| e.t).collect();
+    times.dedup();
     let spacing = median(
         times
             .windows(2)
             .map(|w| w[1] - w[0])
             .filter(|d| *d > 0.0)
             .collect(),
-    );
-    let Some(reach) = spacing.map(|s| GAP_RATIO * s) else {
-        return false;
-    };
-    let (mut shared, mut covered) = (0usize, 0usize);
-    for s in scans {
-        let i = times.partition_point(|t| *t < s.t - 1e-7);
-        let nearest = [i.checked_sub(1), Some(i)]
-            .into_iter()
-            .flatten()
-            .filter_map(|k| times.get(k))
-            .map(|t| (t - s.t).abs())
-            .fold(f64::INFINITY, f64::min);
-        if nearest <= reach {
-            covered += 1;
-            if nearest <= 1e-7 {
-                shared += 1;
+    )?;
+    let reach = GAP_RATIO * spacing;
+    // Every difference (laser stamp − encoder stamp) within the range, for a sample of
+    // the scans.
+    let every = scans.len().div_ceil(OFFSET_SAMPLES).max(1);
+    let mut differences: Vec<f64> = Vec::new();
+    for s in scans.iter().step_by(every) {
+        let lo = times.partition_point(|t| *t < s.t - center - QUICK_RANGE_S);
+        let hi = times.partition_point(|t| *t <= s.t - center + QUICK_RANGE_S);
+        differences.extend(times[lo..hi].iter().map(|t| s.t - t));
+    }
+    differences.sort_unstable_by(f64::total_cmp);
+    // How many differences lie within SAME_STAMP_S above each one.
+    let mut end = 0;
+    let counts: Vec<usize> = (0..differences.len())
+        .map(|i| {
+            end = end.max(i);
+            while end < differences.len() && differences[end] <= differences[i] + SAME_STAMP_S {
+                end += 1;
+            }
+            end - i
+        })
+        .collect();
+    // Most scans stamped by the encoders' clock moved by `offset`.
+    let shared_at = |offset: f64| {
+        let (mut shared, mut covered) = (0usize, 0usize);
+        for s in scans {
+            let t = s.t - offset;
+            let i = times.partition_point(|e| *e < t);
+            let nearest = [i.checked_sub(1), Some(i)]
+                .into_iter()
+                .flatten()
+                .filter_map(|k| times.get(k))
+                .map(|e| (e - t).abs())
+                .fold(f64::INFINITY, f64::min);
+            if nearest <= reach {
+                covered += 1;
+                if nearest <= SAME_STAMP_S {
+                    shared += 1;
+                }
             }
         }
+        2 * shared > covered
+    };
+    // The differences shared by the most scans of the sample, most first.
+    let mut order: Vec<usize> = (0..counts.len()).collect();
+    order.sort_by_key(|&i| (std::cmp::Reverse(counts[i]), i));
+    let mut tried: Vec<f64> = Vec::new();
+    for i in order {
+        if tried.len() == CANDIDATES {
+            break;
+        }
+        if tried
+            .iter()
+            .any(|d| (differences[i] - d).abs() <= 2.0 * SAME_STAMP_S)
+        {
+            continue;
+        }
+        tried.push(differences[i]);
+        let offset = differences[i + counts[i] / 2];
+        if shared_at(offset) {
+            return Some(offset);
+        }
     }
-    2 * shared > covered
+    None
 }
 
 /// The jitter of the scan timestamps, when they have stamps of their own; `None`
-/// when too few scans or the scans share the encoders' stamps.
-pub fn estimate(scans: &[ScanMeta], encoders: &[EncoderRecord]) -> Option<ScanJitter> {
-    if scans.len() < MIN_SCANS || shares_encoder_stamps(scans, encoders) {
+/// when too few scans or the scans share the encoders' stamps, as they are or moved
+/// by one constant within ±[`QUICK_RANGE_S`] of `time_offset` (the offset in use, s,
+/// laser clock minus encoder clock).
+pub fn estimate(
+    scans: &[ScanMeta],
+    encoders: &[EncoderRecord],
+    time_offset: f64,
+) -> Option<ScanJitter> {
+    if scans.len() < MIN_SCANS || shared_stamp_offset(scans, encoders, time_offset).is_some() {
         return None;
     }
     let dt: Vec<f64> = scans.windows(2).map(|w| w[1].t - w[0].t).collect();
@@ -163,7 +239,7 @@ mod tests {
         let t = stamps(1000);
         let scans: Vec<ScanMeta> = t.iter().map(|&t| scan(t)).collect();
         let all: Vec<EncoderRecord> = t.iter().map(|&t| encoder(t)).collect();
-        assert_eq!(estimate(&scans, &all), None);
+        assert_eq!(estimate(&scans, &all, 0.0), None);
         // The encoder records of 60 % of the log removed (a gap of 60 s).
         let gapped: Vec<EncoderRecord> = t
             .iter()
@@ -171,12 +247,46 @@ mod tests {
             .filter(|(i, _)| !(100..700).contains(i))
             .map(|(_, &t)| encoder(t))
             .collect();
-        assert_eq!(estimate(&scans, &gapped), None);
+        assert_eq!(estimate(&scans, &gapped, 0.0), None);
         // The same scans beside encoders of their own clock (50 Hz): the jitter shows.
         let own: Vec<EncoderRecord> = (0..5000)
             .map(|k| encoder(0.003 + 0.02 * k as f64))
             .collect();
-        let j = estimate(&scans, &own).expect("an estimate");
+        let j = estimate(&scans, &own, 0.0).expect("an estimate");
         assert!(j.detected(), "{j:?}");
+    }
+
+    /// Every encoder stamp moved by one constant (an encoder clock set apart) leaves
+    /// the verdict on the same laser stamps as it is: shared stamps stay shared (also
+    /// across a gap, and around an offset in use far from zero), and stamps of their
+    /// own give the same estimate.
+    #[test]
+    fn an_encoder_clock_set_apart_by_a_constant_leaves_the_verdict_alone() {
+        let t = stamps(1000);
+        let scans: Vec<ScanMeta> = t.iter().map(|&t| scan(t)).collect();
+        let own = |shift: f64| -> Vec<EncoderRecord> {
+            (0..5000)
+                .map(|k| encoder(0.003 + shift + 0.02 * k as f64))
+                .collect()
+        };
+        let reference = estimate(&scans, &own(0.0), 0.0).expect("an estimate");
+        for shift in [0.5, -0.5, 1.3, -1.9] {
+            let moved: Vec<EncoderRecord> = t.iter().map(|&t| encoder(t + shift)).collect();
+            assert_eq!(estimate(&scans, &moved, 0.0), None, "{shift}");
+            let gapped: Vec<EncoderRecord> = t
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| !(100..700).contains(i))
+                .map(|(_, &t)| encoder(t + shift))
+                .collect();
+            assert_eq!(estimate(&scans, &gapped, 0.0), None, "{shift}");
+            let far: Vec<EncoderRecord> = t.iter().map(|&t| encoder(t - 20.0 + shift)).collect();
+            assert_eq!(estimate(&scans, &far, 20.0), None, "{shift}");
+            assert_eq!(
+                estimate(&scans, &own(shift), 0.0),
+                Some(reference),
+                "{shift}"
+            );
+        }
     }
 }
