@@ -66,12 +66,14 @@ fn solve_agrees_with_calibrate_on_its_samples() {
     assert!(c.status.success(), "{}", text(&c.stderr));
     let tuples = dir.join("samples.tuple");
     let cj: serde_json::Value = serde_json::from_slice(&c.stdout).unwrap();
-    // calibrate's σ hold the matcher's bias on rotations, from the log's range noise
-    // and ray spacing, which a tuple file does not carry: stated to solve.
+    // calibrate's σ hold the matcher's bias on rotations, from the log's lines' tilt
+    // noise (or range noise and ray spacing), which a tuple file does not carry:
+    // stated to solve.
     let check = &cj["match_self_check"];
     let bias = odocal_pipeline::matcher_bias::matcher_bias_sd(
         check["range_noise_m"].as_f64().unwrap(),
         check["ray_spacing_rad"].as_f64().unwrap(),
+        check["tilt_sigma_rad"].as_f64(),
     );
     assert!(bias[2] > 0.0, "{check}");
     let bias = format!("{},{},{}", bias[0], bias[1], bias[2]);

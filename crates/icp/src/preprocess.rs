@@ -33,6 +33,9 @@ pub(crate) struct SegmentLine {
     pub centroid_along: f64,
 }
 
+/// Fewest usable segments for a scan's [`PreparedScan::typical_tilt_sigma`].
+const MIN_TILT_SEGMENTS: usize = 10;
+
 /// The k-d tree over a scan's valid points (leaf size 32; items are indices into
 /// [`PreparedScan::points`]).
 pub(crate) type PointTree = ImmutableKdTree<f64, u32, 2, 32>;
@@ -429,6 +432,30 @@ impl PreparedScan {
     /// too few straight stretches to tell).
     pub fn noise_sigma(&self) -> Option<f64> {
         self.noise_sigma
+    }
+
+    /// The typical tilt noise of the scan's local lines (σ, rad): the median, over
+    /// the segments with a usable line, of the tilt's standard deviation under the
+    /// range noise the scan shows itself. What the matcher's errors-in-variables
+    /// bias grows with (`odocal_pipeline::matcher_bias`). `None` with fewer than 10
+    /// usable segments or no measured noise (sparse scans matched without local
+    /// lines).
+    pub fn typical_tilt_sigma(&self) -> Option<f64> {
+        if !(self.tilt_noise_scale.is_finite() && self.tilt_noise_scale > 0.0) {
+            return None;
+        }
+        let mut tilts: Vec<f64> = self
+            .segments
+            .iter()
+            .flatten()
+            .map(|s| (self.tilt_noise_scale * s.tilt_variance).sqrt())
+            .filter(|t| t.is_finite())
+            .collect();
+        if tilts.len() < MIN_TILT_SEGMENTS {
+            return None;
+        }
+        let mid = tilts.len() / 2;
+        Some(*tilts.select_nth_unstable_by(mid, f64::total_cmp).1)
     }
 
     /// Number of readings (valid or not).

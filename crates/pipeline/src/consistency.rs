@@ -415,6 +415,7 @@ mod tests {
             theta_rad: 3.0 * sm[2],
             range_noise_m: 0.01,
             ray_spacing_rad: 0.006,
+            tilt_sigma_rad: None,
             sigma_factor: 1.0,
         };
         let Consistency::Checked(scaled) = check_halves(&samples, &opts, Some(&check)) else {

@@ -752,6 +752,8 @@ fn pooled_self_check(outcomes: &[&Outcome]) -> Option<MatchSelfCheck> {
     noise.sort_by(f64::total_cmp);
     let mut spacing: Vec<f64> = checks.iter().map(|c| c.ray_spacing_rad).collect();
     spacing.sort_by(f64::total_cmp);
+    let mut tilt: Vec<f64> = checks.iter().filter_map(|c| c.tilt_sigma_rad).collect();
+    tilt.sort_by(f64::total_cmp);
     Some(MatchSelfCheck {
         triples,
         tried: checks.iter().map(|c| c.tried).sum(),
@@ -759,6 +761,7 @@ fn pooled_self_check(outcomes: &[&Outcome]) -> Option<MatchSelfCheck> {
         theta_rad: mean_square(|c| c.theta_rad),
         range_noise_m: noise[noise.len() / 2],
         ray_spacing_rad: spacing[spacing.len() / 2],
+        tilt_sigma_rad: tilt.get(tilt.len() / 2).copied(),
         sigma_factor: 1.0,
     })
 }

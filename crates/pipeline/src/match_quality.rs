@@ -208,6 +208,7 @@ mod tests {
             theta_rad,
             range_noise_m: 0.001,
             ray_spacing_rad: 0.006,
+            tilt_sigma_rad: None,
             sigma_factor: 1.0,
         }
     }

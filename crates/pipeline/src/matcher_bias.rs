@@ -12,12 +12,27 @@
 //! noise makes both about 3–5× larger (ℓx +102 ± 25 µm): an errors-in-variables
 //! effect of the local lines' tilt noise.
 //!
-//! That tilt noise is what the figures scale with: the variance of a line fitted to
-//! a fixed number of neighbouring points goes as (range noise / ray spacing)² at a
-//! given range, so the bias's standard deviations are the figures above times
-//! `((noise / 1.71 mm) · (2π/1024 / spacing))²`. The sign depends on the scene
-//! (which side of the laser the walls are), so it is a standard deviation, not a
-//! correction.
+//! That tilt noise is what the figures scale with. The log measures it: the median
+//! tilt σ of its scans' local lines ([`odocal_icp::PreparedScan::typical_tilt_sigma`],
+//! [`crate::matching::ScanNoise`]), 0.089–0.106 rad on the Table I rows and the
+//! Khepera preset (reference [`REFERENCE_TILT_SIGMA_RAD`]). Raising the range noise
+//! of 300 s Khepera logs (16 seeds each) from 3 to 6 and 12 mm raised that tilt by
+//! 1.82× and 2.84× and moved the rotation by −3.8e-5 ± 2.2e-5, −1.54e-4 ± 0.30e-4
+//! and −8.8e-4 ± 0.9e-4 of itself (about the cube of the tilt ratio: 6× and 23×
+//! where the cube says 6.0× and 22.9×), ℓx by +39 ± 14, +96 ± 31 and +217 ± 140 µm
+//! and ℓy by +27 ± 18, +53 ± 43 and +381 ± 126 µm (about its square: 3.3× and 8.1×).
+//! So the standard deviations are the reference figures times the tilt ratio cubed
+//! (rotation) and squared (translation).
+//!
+//! An earlier version took the tilt noise as (range noise / ray spacing)², which
+//! leaves out the range: a TurtleBot 4 / RPLIDAR in an office (10 mm noise, rays
+//! 0.5° apart, walls 1–5 m away) came out at 17× the reference where its lines'
+//! tilt is the reference's (0.094–0.103 rad), and the term made ℓx's and ℓy's σ
+//! 1.5× too wide (RMS error/σ 0.58 and 0.49 over 30 seeds; 0.90 and 0.68 without
+//! the term), while its rotations showed no bias (−8e-5 ± 7e-5 of themselves). It
+//! is still the rule for scans without local lines (sparse scans matched point to
+//! point), whose tilt is not measured. The sign depends on the scene (which side of
+//! the laser the walls are), so it is a standard deviation, not a correction.
 
 /// Typical range noise (m) of the logs the figures below were measured on.
 pub const REFERENCE_RANGE_NOISE_M: f64 = 1.71e-3;
@@ -25,6 +40,10 @@ pub const REFERENCE_RANGE_NOISE_M: f64 = 1.71e-3;
 /// Angle between neighbouring rays (rad) of the logs the figures were measured on
 /// (the URG-04LX's 2π/1024).
 pub const REFERENCE_RAY_SPACING_RAD: f64 = std::f64::consts::TAU / 1024.0;
+
+/// Typical tilt σ of the local lines (rad) of the logs the figures were measured on
+/// (the median over the Table I rows and the Khepera preset, two seeds each).
+pub const REFERENCE_TILT_SIGMA_RAD: f64 = 0.097;
 
 /// The rotation bias's standard deviation at the reference noise and spacing
 /// (rad/rad).
@@ -34,12 +53,24 @@ pub const REFERENCE_ROTATION_BIAS: f64 = 4.0e-5;
 /// spacing (m/rad).
 pub const REFERENCE_TRANSLATION_BIAS_M: f64 = 35e-6;
 
-/// The standard deviations `(x, y, θ)` of the matcher's bias on a log whose typical
-/// range noise is `range_noise_m` and whose rays are `ray_spacing_rad` apart (0 or
-/// not finite: the reference spacing). No noise: no term.
-pub fn matcher_bias_sd(range_noise_m: f64, ray_spacing_rad: f64) -> [f64; 3] {
+/// The standard deviations `(x, y, θ)` of the matcher's bias on a log whose local
+/// lines' typical tilt σ is `tilt_sigma_rad`: the reference figures times the tilt
+/// ratio squared (translation) and cubed (rotation). Without a measured tilt (`None`,
+/// not finite or not positive), from the typical range noise `range_noise_m` and the
+/// rays' spacing `ray_spacing_rad` (0 or not finite: the reference spacing), both
+/// squared. No noise: no term.
+pub fn matcher_bias_sd(
+    range_noise_m: f64,
+    ray_spacing_rad: f64,
+    tilt_sigma_rad: Option<f64>,
+) -> [f64; 3] {
     if !(range_noise_m.is_finite() && range_noise_m > 0.0) {
         return [0.0; 3];
+    }
+    if let Some(tilt) = tilt_sigma_rad.filter(|t| t.is_finite() && *t > 0.0) {
+        let ratio = tilt / REFERENCE_TILT_SIGMA_RAD;
+        let t = REFERENCE_TRANSLATION_BIAS_M * ratio.powi(2);
+        return [t, t, REFERENCE_ROTATION_BIAS * ratio.powi(3)];
     }
     let spacing = if ray_spacing_rad.is_finite() && ray_spacing_rad > 0.0 {
         ray_spacing_rad
@@ -53,13 +84,13 @@ pub fn matcher_bias_sd(range_noise_m: f64, ray_spacing_rad: f64) -> [f64; 3] {
 }
 
 /// `options` with the matcher-bias term of the log(s) behind `synced` (from its
-/// self-check's range noise and ray spacing; none without a self-check).
+/// self-check's tilt, range noise and ray spacing; none without a self-check).
 pub fn with_matcher_bias(
     options: odocal_solver::SolveOptions,
     synced: &crate::synchronized::Synchronized,
 ) -> odocal_solver::SolveOptions {
     let matcher_bias = synced.match_self_check.as_ref().map_or([0.0; 3], |c| {
-        matcher_bias_sd(c.range_noise_m, c.ray_spacing_rad)
+        matcher_bias_sd(c.range_noise_m, c.ray_spacing_rad, c.tilt_sigma_rad)
     });
     odocal_solver::SolveOptions {
         matcher_bias,
@@ -73,16 +104,46 @@ mod tests {
 
     #[test]
     fn grows_with_the_tilt_noise_and_vanishes_without_noise() {
-        assert_eq!(matcher_bias_sd(0.0, 0.006), [0.0; 3]);
-        assert_eq!(matcher_bias_sd(f64::NAN, 0.006), [0.0; 3]);
-        let one = matcher_bias_sd(REFERENCE_RANGE_NOISE_M, REFERENCE_RAY_SPACING_RAD);
+        assert_eq!(matcher_bias_sd(0.0, 0.006, None), [0.0; 3]);
+        assert_eq!(matcher_bias_sd(f64::NAN, 0.006, Some(0.1)), [0.0; 3]);
+        let one = matcher_bias_sd(REFERENCE_RANGE_NOISE_M, REFERENCE_RAY_SPACING_RAD, None);
         assert_eq!(one, [35e-6, 35e-6, 4e-5]);
         // Unknown spacing: the reference's.
-        assert_eq!(matcher_bias_sd(REFERENCE_RANGE_NOISE_M, 0.0), one);
-        let noisier = matcher_bias_sd(2.0 * REFERENCE_RANGE_NOISE_M, REFERENCE_RAY_SPACING_RAD);
+        assert_eq!(matcher_bias_sd(REFERENCE_RANGE_NOISE_M, 0.0, None), one);
+        let noisier = matcher_bias_sd(
+            2.0 * REFERENCE_RANGE_NOISE_M,
+            REFERENCE_RAY_SPACING_RAD,
+            None,
+        );
         assert!((noisier[2] / one[2] - 4.0).abs() < 1e-12);
         // Rays twice as far apart: lines twice as long, a quarter of the tilt variance.
-        let sparser = matcher_bias_sd(REFERENCE_RANGE_NOISE_M, 2.0 * REFERENCE_RAY_SPACING_RAD);
+        let sparser = matcher_bias_sd(
+            REFERENCE_RANGE_NOISE_M,
+            2.0 * REFERENCE_RAY_SPACING_RAD,
+            None,
+        );
         assert!((sparser[2] / one[2] - 0.25).abs() < 1e-12);
+    }
+
+    /// A measured tilt decides, whatever the range noise and spacing: the reference
+    /// tilt gives the reference figures (a noisy, coarse laser whose walls are far
+    /// has no more bias than the reference); twice the tilt, 4× the translation and
+    /// 8× the rotation term.
+    #[test]
+    fn a_measured_tilt_decides() {
+        let reference = Some(REFERENCE_TILT_SIGMA_RAD);
+        let rplidar = matcher_bias_sd(0.0102, 0.0087, reference);
+        let [t, _, r] = rplidar;
+        assert!((t - 35e-6).abs() < 1e-15 && (r - 4e-5).abs() < 1e-15);
+        let doubled = matcher_bias_sd(0.0102, 0.0087, Some(2.0 * REFERENCE_TILT_SIGMA_RAD));
+        assert!((doubled[0] / t - 4.0).abs() < 1e-12);
+        assert!((doubled[2] / r - 8.0).abs() < 1e-12);
+        // No usable tilt: the range-noise rule.
+        for tilt in [None, Some(0.0), Some(f64::NAN)] {
+            assert_eq!(
+                matcher_bias_sd(0.0102, 0.0087, tilt),
+                matcher_bias_sd(0.0102, 0.0087, None)
+            );
+        }
     }
 }

@@ -130,24 +130,54 @@ pub(crate) fn prepare_scan(
     })
 }
 
+/// A log's typical scan noise (see [`typical_scan_noise`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScanNoise {
+    /// The median range noise (σ, m) of the scans whose noise shows; 0 when none
+    /// does.
+    pub range_sigma_m: f64,
+    /// The median of the scans' [`odocal_icp::PreparedScan::typical_tilt_sigma`]
+    /// (rad): how noisy the tilt of their local lines is; `None` when no scan has
+    /// enough usable lines.
+    pub tilt_sigma_rad: Option<f64>,
+}
+
 /// The median range noise (σ, m) of up to [`NOISE_SAMPLE_SCANS`] scans spread evenly
 /// over the store, among those whose noise shows (straight stretches); 0 when none
 /// does. What the matcher's consistency test assumes for scans too cluttered or
 /// sparse to show their own.
 pub fn typical_noise_sigma(scans: &ScanStore, params: &IcpParams) -> f64 {
+    typical_scan_noise(scans, params).range_sigma_m
+}
+
+/// [`typical_noise_sigma`] and, from the same scans, the median tilt noise of their
+/// local lines.
+pub fn typical_scan_noise(scans: &ScanStore, params: &IcpParams) -> ScanNoise {
     let every = (scans.len() / NOISE_SAMPLE_SCANS).max(1);
     let sampled: Vec<usize> = (0..scans.len()).step_by(every).collect();
     let rays = store_rays(scans);
     // On the current pool's threads; collected in scan order.
-    let mut noise: Vec<f64> = sampled
+    let (noise, tilt): (Vec<Option<f64>>, Vec<Option<f64>>) = sampled
         .into_par_iter()
-        .filter_map(|i| prepare_scan(scans, &rays, i, params)?.ok()?.noise_sigma())
-        .collect();
-    if noise.is_empty() {
-        return 0.0;
+        .filter_map(|i| {
+            let scan = prepare_scan(scans, &rays, i, params)?.ok()?;
+            Some((scan.noise_sigma(), scan.typical_tilt_sigma()))
+        })
+        .unzip();
+    ScanNoise {
+        range_sigma_m: median(noise).unwrap_or(0.0),
+        tilt_sigma_rad: median(tilt),
     }
-    let mid = noise.len() / 2;
-    *noise.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// The median of the values present (the upper one of an even count).
+fn median(values: Vec<Option<f64>>) -> Option<f64> {
+    let mut present: Vec<f64> = values.into_iter().flatten().collect();
+    if present.is_empty() {
+        return None;
+    }
+    let mid = present.len() / 2;
+    Some(*present.select_nth_unstable_by(mid, f64::total_cmp).1)
 }
 
 /// `params` with [`IcpParams::typical_noise_sigma`] set to `store_noise` (the store's

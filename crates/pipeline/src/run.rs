@@ -6,7 +6,9 @@ use crate::error::PipelineError;
 use crate::finding::{Finding, FindingKind};
 use crate::health;
 use crate::local_map::rescue_with_neighbours;
-use crate::matching::{match_pairs, typical_noise_sigma, with_typical_noise, MatchStats};
+use crate::matching::{
+    match_pairs, typical_noise_sigma, typical_scan_noise, with_typical_noise, MatchStats,
+};
 use crate::options::{Options, BOOTSTRAP_PAIRS, BOOTSTRAP_RUN, MIN_SAMPLES};
 use crate::progress::Progress;
 use crate::refusal;
@@ -190,8 +192,8 @@ pub fn synchronize_and_match(
     let bootstrap = (opts.bootstrap_guesses || sweep) && kept.len() >= MIN_SAMPLES;
     // The log's typical range noise, estimated once for every match of its scans.
     let matcher = opts.icp_for(log);
-    let log_noise = typical_noise_sigma(&log.scans, &matcher);
-    let log_icp = with_typical_noise(&matcher, log_noise);
+    let log_noise = typical_scan_noise(&log.scans, &matcher);
+    let log_icp = with_typical_noise(&matcher, log_noise.range_sigma_m);
     if guess_params.is_none() && bootstrap {
         // Match a subset with identity guesses (an evenly spread one of long logs,
         // every pair of short ones), solve roughly, and guess the rest — and the
@@ -274,8 +276,8 @@ pub fn synchronize_and_match(
     let (noise, icp) = match &scans {
         Cow::Borrowed(_) => (log_noise, log_icp),
         Cow::Owned(store) => {
-            let noise = typical_noise_sigma(store, &matcher);
-            (noise, with_typical_noise(&matcher, noise))
+            let noise = typical_scan_noise(store, &matcher);
+            (noise, with_typical_noise(&matcher, noise.range_sigma_m))
         }
     };
     let rest: Vec<usize> = (0..kept.len()).filter(|&i| matched[i].is_none()).collect();

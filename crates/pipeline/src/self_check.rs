@@ -9,7 +9,7 @@
 //! variance is about three times one match's, so one match's error is the closure's
 //! RMS over √3.
 
-use crate::matching::{match_pairs, MatchStats};
+use crate::matching::{match_pairs, MatchStats, ScanNoise};
 use crate::samples::PairSample;
 use odocal_geom::{wrap_angle, Pose2};
 use odocal_icp::IcpParams;
@@ -35,6 +35,10 @@ pub struct MatchSelfCheck {
     pub theta_rad: f64,
     /// The median range noise of the log's scans (m), for scale.
     pub range_noise_m: f64,
+    /// The median tilt noise of the log's local lines (rad; `None` when its scans
+    /// have too few, e.g. sparse scans): what the matcher's bias on rotations
+    /// grows with ([`crate::matcher_bias`]).
+    pub tilt_sigma_rad: Option<f64>,
     /// The angle between neighbouring rays of the log's scans (rad; 0 when unknown):
     /// with the range noise it sets the local lines' tilt noise
     /// ([`crate::matcher_bias`]).
@@ -46,14 +50,14 @@ pub struct MatchSelfCheck {
 
 /// Measures the matcher's error on `samples` (in time order) with the scans they
 /// were matched on; `None` when fewer than [`MIN_TRIPLES`] triples close.
-/// `range_noise_m` is the store's [`crate::matching::typical_noise_sigma`], and
-/// `params` those the samples were matched with, their typical noise set (see
+/// `noise` is the store's [`crate::matching::typical_scan_noise`], and `params`
+/// those the samples were matched with, their typical noise set (see
 /// [`crate::matching::with_typical_noise`]).
 pub fn closure_check(
     scans: &ScanStore,
     samples: &[PairSample],
     params: &IcpParams,
-    range_noise_m: f64,
+    noise: ScanNoise,
 ) -> Option<MatchSelfCheck> {
     let triples: Vec<(&MatchStats, &MatchStats, (usize, usize))> = samples
         .windows(2)
@@ -99,7 +103,8 @@ pub fn closure_check(
         // Per axis: the sum over x and y is two axes; three matches per closure.
         xy_m: (sum_xy / (2.0 * 3.0 * n_f)).sqrt(),
         theta_rad: (sum_theta / (3.0 * n_f)).sqrt(),
-        range_noise_m,
+        range_noise_m: noise.range_sigma_m,
+        tilt_sigma_rad: noise.tilt_sigma_rad,
         ray_spacing_rad: scans
             .get(pairs[0].0)
             .map_or(0.0, |s| s.geometry.resolution.abs()),
