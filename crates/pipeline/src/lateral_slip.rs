@@ -83,9 +83,39 @@ pub enum SlideModel {
 }
 
 /// Whether a slide matters: ignoring it moves some parameter by more than its σ in
-/// `covariance` (the six-parameter estimate's); the parameter and by how many σ.
+/// `covariance` (the calibration's); the parameter and by how many σ.
 fn matters(slip: &LateralSlip, covariance: &[[f64; 6]; 6]) -> Option<(usize, f64)> {
     slip.largest_shift(covariance).filter(|(_, n)| *n > 1.0)
+}
+
+/// Share of a parameter's variance from not knowing `k` above which it is said.
+const UNKNOWN_K_SAID: f64 = 0.5;
+
+/// "not knowing k makes up 97 % of ℓx's variance (σ 29.4 mm)": the parameter whose
+/// variance in `covariance` (the calibration's) is most not knowing `k`, when that
+/// is more than [`UNKNOWN_K_SAID`] of it.
+fn unknown_k_words(slip: &LateralSlip, covariance: &[[f64; 6]; 6]) -> Option<String> {
+    let share = slip.unknown_k_share(covariance);
+    let (i, most) = share
+        .iter()
+        .copied()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    (most > UNKNOWN_K_SAID).then(|| {
+        let sigma = covariance[i][i].sqrt();
+        let sigma = if i == 5 {
+            format!("{:.4} rad ({:.2}°)", sigma, sigma.to_degrees())
+        } else {
+            format!("{:.1} mm", 1e3 * sigma)
+        };
+        format!(
+            "not knowing k makes up {:.0} % of {}'s variance (σ {sigma}): spins in place \
+             determine the laser's pose without it; if the wheels cannot slide sideways \
+             (differential drive), `--no-lateral-slip` leaves it out",
+            100.0 * most,
+            odocal_solver::PARAMETER_NAMES[i]
+        )
+    })
 }
 
 /// "ℓθ by −0.0050 rad (−0.29°), 2.2 times its σ": what ignoring the slide does to
@@ -174,10 +204,12 @@ pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> 
             ),
         ));
     }
+    let unknown = unknown_k_words(slip, &calibration.covariance);
     if slip.applied {
-        // Weighed: said when it carries weight or would matter in full.
+        // Weighed: said when it carries weight, would matter in full, or its not
+        // being known makes up most of a σ.
         let moved = matters(slip, &calibration.covariance);
-        if slip.weight < 0.5 && moved.is_none() {
+        if slip.weight < 0.5 && moved.is_none() && unknown.is_none() {
             return None;
         }
         let also = match moved {
@@ -188,17 +220,30 @@ pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> 
             "{what}: {numbers}; {shift}{also}; the estimate weighs the model with the \
              slide at {:.0} % and the one without at {:.0} %, by the evidence for it (k at \
              {:.1}σ of the residuals' noise; even odds at {PRECAUTION}σ, all but certain from \
-             {SIGNIFICANCE}σ), and the σ of every parameter include both models and the \
-             difference between them (`--lateral-slip` estimates the slide in full, as a \
-             skid-steer robot needs; `--no-lateral-slip` leaves it out)",
+             {SIGNIFICANCE}σ), and the σ of every parameter include not knowing k and the \
+             difference between the models (`--lateral-slip` estimates the slide in full, \
+             as a skid-steer robot needs; `--no-lateral-slip` leaves it out){}",
             100.0 * slip.weight,
             100.0 * (1.0 - slip.weight),
             slip.evidence,
+            unknown.map_or(String::new(), |u| format!("; {u}")),
         );
         return Some(if slip.weight >= 0.5 {
             Finding::warning(FindingKind::LateralSlip, message)
         } else {
             Finding::note(FindingKind::LateralSlip, message)
+        });
+    }
+    if slip.significance() <= SIGNIFICANCE || slip.k >= 0.0 {
+        // Not weighed in (k inward or zero), yet not knowing it may be most of a σ.
+        return unknown.map(|u| {
+            Finding::note(
+                FindingKind::LateralSlip,
+                format!(
+                    "{what}: {numbers}; the data do not show the slide, nor rule it out: \
+                     {u}"
+                ),
+            )
         });
     }
     (slip.significance() > SIGNIFICANCE && slip.k < 0.0).then(|| {
@@ -292,7 +337,7 @@ mod tests {
     }
 
     #[test]
-    fn a_weighed_slide_moves_the_estimate_in_proportion_and_widens_sigma_by_the_gap() {
+    fn a_weighed_slide_moves_the_estimate_in_proportion_and_widens_sigma_by_k_and_the_gap() {
         use odocal_geom::Pose2;
         use odocal_solver::{calibrate, fit_lateral_slip, Predictor};
         let predictor = Predictor::new(&robot(0.1), true);
@@ -320,8 +365,12 @@ mod tests {
             let (got, base) = (cal.params.to_vector(), six.params.to_vector());
             for i in 0..6 {
                 assert!((got[i] - (base[i] + w * d[i])).abs() < 1e-12, "w {w}, {i}");
-                let want =
-                    (1.0 - w) * six.covariance[i][i] + w * c7[i][i] + w * (1.0 - w) * d[i] * d[i];
+                // Not knowing k: in full with the slide (C₇), as far as a plausible
+                // slide goes without it (C₀); and the gap between the models.
+                let share = fit.slip.plausible_share();
+                let c0 = six.covariance[i][i] + share * (c7[i][i] - six.covariance[i][i]);
+                let want = (1.0 - w) * c0 + w * c7[i][i] + w * (1.0 - w) * d[i] * d[i];
+                assert!(want >= six.covariance[i][i], "w {w}, {i}");
                 assert!(
                     (cal.covariance[i][i] - want).abs() <= 1e-12 * want.abs().max(1e-30),
                     "w {w}, {i}"
@@ -336,5 +385,35 @@ mod tests {
         fit.clone().apply(&mut cal);
         assert_eq!(cal.params, fit.params);
         assert_eq!(cal.covariance, fit.covariance);
+    }
+
+    /// A slide the data neither show nor rule out, that makes up most of a σ, is said
+    /// (with what to do); one the data rule out is not.
+    #[test]
+    fn a_slide_the_data_cannot_rule_out_is_said_when_it_makes_up_a_sigma() {
+        // As the blend leaves it: ℓx's variance with k known (σ 5 mm) and what not
+        // knowing k adds, as far as a plausible slide at 0.44 m/s goes.
+        let calibration = |k: f64, sigma_k: f64, cross: f64| {
+            let slip = LateralSlip {
+                covariance_with_params: [0.0, 0.0, 0.0, cross, 0.0, 0.0],
+                turning_speed: 0.44,
+                ..slip(k, sigma_k, -0.025)
+            };
+            let mut cov = [[0.0; 6]; 6];
+            for (i, row) in cov.iter_mut().enumerate() {
+                row[i] = 1e-8;
+            }
+            cov[3][3] = 2.5e-5 + slip.plausible_share() * cross * cross / (sigma_k * sigma_k);
+            (slip, cov)
+        };
+        // k = 0 ± 0.064 s, ℓx's covariance with k 1.84e-3: not knowing k is 8.3e-4 m²
+        // with k free, 65 % of it kept (τ = 0.088 s): 96 % of ℓx's variance.
+        let (slip, cov) = calibration(0.0, 0.064, 1.84e-3);
+        let words = unknown_k_words(&slip, &cov).expect("said");
+        assert!(words.contains("96 % of l_x's variance"), "{words}");
+        assert!(words.contains("--no-lateral-slip"), "{words}");
+        // k = 0 ± 0.005 s: the data rule a plausible slide out.
+        let (slip, cov) = calibration(0.0, 0.005, 1e-6);
+        assert_eq!(unknown_k_words(&slip, &cov), None);
     }
 }
