@@ -40,8 +40,8 @@ pub struct MatchSelfCheck {
     /// grows with ([`crate::matcher_bias`]).
     pub tilt_sigma_rad: Option<f64>,
     /// The angle between neighbouring rays of the log's scans (rad; 0 when unknown):
-    /// with the range noise it sets the local lines' tilt noise
-    /// ([`crate::matcher_bias`]).
+    /// with the range noise it stands for the local lines' tilt noise where that is
+    /// not measured ([`crate::matcher_bias`]).
     pub ray_spacing_rad: f64,
     /// The factor by which this error multiplied the solver's σ (1: the noise model
     /// already covered it; see [`crate::match_quality::sigma_inflation`]).

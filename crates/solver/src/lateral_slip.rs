@@ -116,7 +116,7 @@ impl LateralSlip {
     }
 
     /// The parameter that ignoring the slide moves most in units of its σ in
-    /// `covariance` (the six-parameter estimate's): its index and `|shift| / σ`
+    /// `covariance` (a calibration's): its index and `|shift| / σ`
     /// (held parameters, with zero variance, left out); `None` when none moves.
     pub fn largest_shift(&self, covariance: &[[f64; 6]; 6]) -> Option<(usize, f64)> {
         (0..6)
