@@ -89,7 +89,7 @@ pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residua
 pub use lasers::{
     calibrate_lasers, calibrate_lasers_constrained, laser_constraints, LasersCalibration,
 };
-pub use lateral_slip::{fit_lateral_slip, LateralSlip, SlideFit};
+pub use lateral_slip::{fit_lateral_slip, LateralSlip, SlideFit, PLAUSIBLE_SLIDE_PER_SPEED};
 pub use noise::{residual_sigmas, SIGMA_FLOOR};
 pub use noise_shape::{NoiseShaping, MIN_SHAPED_SAMPLES};
 pub use observability::{
