@@ -1,5 +1,6 @@
 //! The scan-matching stage: ŝ for every synchronized pair, in parallel.
 
+use crate::health::scan_jitter::median;
 use crate::parallel::match_chain;
 use crate::rejection::{MatchFailure, Rejection};
 use odocal_geom::Pose2;
@@ -165,19 +166,9 @@ pub fn typical_scan_noise(scans: &ScanStore, params: &IcpParams) -> ScanNoise {
         })
         .unzip();
     ScanNoise {
-        range_sigma_m: median(noise).unwrap_or(0.0),
-        tilt_sigma_rad: median(tilt),
+        range_sigma_m: median(noise.into_iter().flatten().collect()).unwrap_or(0.0),
+        tilt_sigma_rad: median(tilt.into_iter().flatten().collect()),
     }
-}
-
-/// The median of the values present (the upper one of an even count).
-fn median(values: Vec<Option<f64>>) -> Option<f64> {
-    let mut present: Vec<f64> = values.into_iter().flatten().collect();
-    if present.is_empty() {
-        return None;
-    }
-    let mid = present.len() / 2;
-    Some(*present.select_nth_unstable_by(mid, f64::total_cmp).1)
 }
 
 /// `params` with [`IcpParams::typical_noise_sigma`] set to `store_noise` (the store's
