@@ -10,7 +10,9 @@
 //! 0.3 m and 50° around the guess, and can find there a wrong alignment that
 //! explains a sparse scan better than the right one (a wall's structure repeated
 //! 0.3 m on). The first pass's guesses (the identity, a nominal typed by hand, a rough
-//! bootstrap estimate) keep the matcher's fixed window.
+//! bootstrap estimate) keep the matcher's fixed window, except for the pairs of sparse
+//! scans matched with their neighbours ([`crate::local_map`]): those are guessed by
+//! odometry with the bootstrap's estimate, and take the window of its residuals.
 
 use odocal_icp::GuessWindow;
 
@@ -24,12 +26,13 @@ pub const FLOOR: (f64, f64) = (0.05, 0.0524);
 /// The share of the guessed motion added: the estimate's error, generously.
 pub const MOTION_SHARE: f64 = 0.2;
 
-/// The window of the second pass's matches, from the residuals' σ of the first
-/// solve, `sm_sigma` (x, y, θ; m, m, rad; [`odocal_solver::Calibration::sm_sigma`]):
+/// The window of matches guessed by odometry with an estimate (the second pass's,
+/// and the clouds' of [`crate::local_map`]), from the residuals' σ of the solve that
+/// gave it, `sm_sigma` (x, y, θ; m, m, rad; [`odocal_solver::Calibration::sm_sigma`]):
 /// [`RESIDUAL_SIGMAS`] of them, at least [`FLOOR`], plus [`MOTION_SHARE`] of the
-/// guess. `None` (the matcher's fixed window) when a σ is not finite: the first
-/// solve says nothing of the guesses' error.
-pub fn second_pass(sm_sigma: [f64; 3]) -> Option<GuessWindow> {
+/// guess. `None` (the matcher's fixed window) when a σ is not finite: that solve says
+/// nothing of the guesses' error.
+pub fn from_residuals(sm_sigma: [f64; 3]) -> Option<GuessWindow> {
     if !sm_sigma.iter().all(|s| s.is_finite()) {
         return None;
     }
@@ -48,16 +51,16 @@ mod tests {
     #[test]
     fn the_window_is_the_residuals_spread_or_the_floor() {
         // The simulated Neato's first solve: σ of 3–5 mm, 0.2°: the floor.
-        let w = second_pass([0.004, 0.003, 0.003]).unwrap();
+        let w = from_residuals([0.004, 0.003, 0.003]).unwrap();
         assert_eq!((w.xy, w.theta, w.share), (FLOOR.0, FLOOR.1, MOTION_SHARE));
         // The real MinesRover's (exp1): 20 and 15 mm, 1.0°.
-        let w = second_pass([0.0204, 0.0154, 0.0175]).unwrap();
+        let w = from_residuals([0.0204, 0.0154, 0.0175]).unwrap();
         assert!(
             (w.xy - 5.0 * 0.0204f64.hypot(0.0154)).abs() < 1e-12,
             "{w:?}"
         );
         assert!((w.theta - 5.0 * 0.0175).abs() < 1e-12, "{w:?}");
-        assert_eq!(second_pass([0.004, f64::NAN, 0.003]), None);
-        assert_eq!(second_pass([0.004, 0.003, f64::INFINITY]), None);
+        assert_eq!(from_residuals([0.004, f64::NAN, 0.003]), None);
+        assert_eq!(from_residuals([0.004, 0.003, f64::INFINITY]), None);
     }
 }

@@ -25,6 +25,12 @@
 //! the nominal radii 3 % off either way, the Neato's calibrated radii then move as
 //! they do without the stage. Measured in docs/benchmarks.md, stop 37.
 //!
+//! A cloud's match may end no farther from its guess than the window of the
+//! residuals of the solve whose estimate placed and guessed it
+//! ([`crate::guess_window`]), in the first pass as in the second: a match beyond is one
+//! the solver would trim, and a cloud's share of its own points explained (25 %) is
+//! too low a bar to refuse it alone (docs/benchmarks.md, stop 49).
+//!
 //! Only pairs with a sparse scan (see [`odocal_icp::PreparedScan::is_sparse`]) are
 //! tried, and only for refusals more points cure ([`worth_densifying`]); a pair whose
 //! own scans cannot be prepared is left refused.
@@ -267,6 +273,17 @@ pub fn rescue_with_neighbours(
     let mut prepared = prepare_all(scans, neighbours.into_iter(), &scan_params);
     prepared.extend(own);
     let predictor = Predictor::new(estimate, source.use_profile);
+    // The clouds are placed and guessed by odometry with the estimate: a match far
+    // beyond the error its residuals show is refused, as in the second pass (the
+    // first pass's clouds too: their guesses are odometry with the bootstrap's
+    // estimate, whose residuals' σ is `source.residual_sigma`).
+    let params = &match (&params.guess_window, source.residual_sigma) {
+        (None, Some(sigma)) => IcpParams {
+            guess_window: crate::guess_window::from_residuals(sigma),
+            ..params.clone()
+        },
+        _ => params.clone(),
+    };
     let rescued: Vec<Option<MatchStats>> = refused
         .par_iter()
         .map(|&k| {

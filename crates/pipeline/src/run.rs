@@ -376,7 +376,7 @@ fn second_pass(
     progress: &dyn Progress,
 ) {
     let params = &first.params;
-    let window = crate::guess_window::second_pass(first.sm_sigma);
+    let window = crate::guess_window::from_residuals(first.sm_sigma);
     let motions: Vec<(usize, WheelMotion)> = synced
         .samples
         .iter()
