@@ -723,6 +723,14 @@ fn merged(outcomes: &[&Outcome]) -> Synchronized {
         },
         // Set by the joint solve when its model cannot hold a log's slide.
         unmodelled_slide: None,
+        // One log's unsettled placement weakens the joint verdicts too.
+        unsettled_placement: {
+            let causes: Vec<&str> = outcomes
+                .iter()
+                .filter_map(|o| o.synced.unsettled_placement.as_deref())
+                .collect();
+            (!causes.is_empty()).then(|| causes.join("; "))
+        },
         scan_returns: first.scan_returns,
         // Set by the joint solve when the logs are one log's phases.
         shared_error_factor: 1.0,

@@ -53,6 +53,7 @@ pub mod options;
 pub mod parallel;
 pub mod phase_correlation;
 pub mod phases;
+pub mod placement_rounds;
 mod progress;
 pub mod range_finder;
 pub mod range_scale;

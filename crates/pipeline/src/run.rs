@@ -344,6 +344,7 @@ pub fn synchronize_and_match(
         unrepaired_timing: None,
         heading_not_from_wheels: None,
         unmodelled_slide: None,
+        unsettled_placement: None,
         scan_returns: crate::matching::scan_returns(&log.scans),
         shared_error_factor: 1.0,
     })
@@ -441,6 +442,47 @@ fn second_pass(
     }
 }
 
+/// The second pass with the clouds placed by `first`, then, while the estimate (solved
+/// with `lenient`) moves from the one that placed them, again with them placed halfway
+/// ([`crate::placement_rounds`]); an estimate that does not settle leaves no verdict
+/// "well determined" (`Synchronized::unsettled_placement`).
+fn settle_placement(
+    log: &Log,
+    synced: &mut Synchronized,
+    first: Calibration,
+    opts: &Options,
+    lenient: &Options,
+    progress: &dyn Progress,
+) {
+    use crate::placement_rounds::{
+        halfway, largest_move, unsettled, PLACEMENT_ROUNDS, SETTLED_SIGMAS,
+    };
+    let before = synced.clone();
+    second_pass(log, synced, &first, opts, progress);
+    let mut placed = first;
+    let mut rounds = 0;
+    while synced.samples.iter().any(|s| s.icp.neighbours > 0) {
+        let Ok(next) = solve(synced, lenient) else {
+            return;
+        };
+        let moved = largest_move(&placed.params, &next.params, &next.covariance);
+        if moved <= SETTLED_SIGMAS {
+            return;
+        }
+        if rounds == PLACEMENT_ROUNDS {
+            synced.unsettled_placement = Some(unsettled(moved, rounds));
+            return;
+        }
+        placed = Calibration {
+            params: halfway(&placed.params, &next.params),
+            ..next
+        };
+        *synced = before.clone();
+        second_pass(log, synced, &placed, opts, progress);
+        rounds += 1;
+    }
+}
+
 /// Recomputes every sample's wheel motion at a new clock offset, discarding (and
 /// counting) the pairs that no longer synchronize.
 pub fn resynchronize(log: &Log, synced: &mut Synchronized, offset: f64) {
@@ -535,6 +577,7 @@ pub(crate) fn refuse_poorly_determined(
                 .as_ref()
                 .map(|_| health::gyro_heading::CAUSE.to_string()),
             synced.unmodelled_slide.clone(),
+            synced.unsettled_placement.clone(),
         ]
         .into_iter()
         .flatten()
@@ -751,7 +794,7 @@ pub fn calibrate_log(
         };
         timing.solve += t_solve.elapsed().as_secs_f64();
         let t = Instant::now();
-        second_pass(log, &mut synced, &first, opts, progress);
+        settle_placement(log, &mut synced, first, opts, &lenient, progress);
         timing.r#match += t.elapsed().as_secs_f64();
         if let (true, Some(est)) = (sweep, offset.as_ref()) {
             // The offset was estimated on scans compensated at the starting offset

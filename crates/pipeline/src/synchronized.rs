@@ -47,6 +47,10 @@ pub struct Synchronized {
     /// solved together, one of whose logs slides; see [`crate::lateral_slip`]), in
     /// words: while it is set no parameter is judged well determined.
     pub unmodelled_slide: Option<String>,
+    /// The estimate that places the neighbouring scans of the pairs matched with them
+    /// did not settle (see [`crate::placement_rounds`]), in words: while it is set no
+    /// parameter is judged well determined.
+    pub unsettled_placement: Option<String>,
     /// The scans' returns: the median count of readings within the laser's range
     /// per scan and the rays per scan (of the first log, with several), when any
     /// scan was read; a refusal for too few matches names it.
@@ -72,12 +76,14 @@ impl Synchronized {
     }
 
     /// What keeps every verdict from "well determined" (unrepaired timing, a heading
-    /// not from the wheels, a slide not modelled), in words; `None` when nothing does.
+    /// not from the wheels, a slide not modelled, a placement that did not settle), in
+    /// words; `None` when nothing does.
     pub fn unjudgeable(&self) -> Option<String> {
         let causes: Vec<&str> = [
             &self.unrepaired_timing,
             &self.heading_not_from_wheels,
             &self.unmodelled_slide,
+            &self.unsettled_placement,
         ]
         .into_iter()
         .filter_map(|c| c.as_deref())
