@@ -7,27 +7,36 @@
 //! parameter within 3σ of the truth (over 30 seeds: 29 calibrated, RMS error/σ
 //! 0.74–1.27; docs/benchmarks.md, "The sparse matcher's σ bound").
 
-use odocal_pipeline::{calibrate_log, Estimate, NoProgress, Options};
+use odocal_pipeline::{calibrate_log, Estimate, NoProgress, Options, Outcome};
 use odocal_sim::{simulate_in, SimConfig, World};
+
+/// A `neato-lds` log of `seed` and `duration` s calibrated (`--accept-weak`), and the
+/// true parameters (r_L, r_R, b, ℓx, ℓy, ℓθ).
+fn calibrated(seed: u64, duration: f64) -> (Outcome, [f64; 6]) {
+    let mut config = SimConfig::preset("neato-lds").unwrap();
+    config.seed = seed;
+    config.duration = duration;
+    let world = World::preset(&config.world).unwrap();
+    let run = simulate_in(&config, &world).unwrap();
+    let opts = Options {
+        accept_weak: true,
+        ..Options::default()
+    };
+    let outcome = calibrate_log(&run.to_log(), &opts, &NoProgress)
+        .unwrap_or_else(|e| panic!("seed {seed} refused: {e}"));
+    (
+        outcome,
+        odocal_geom::FlatParams::from(config.robot).to_array(),
+    )
+}
 
 #[test]
 fn neato_logs_refused_under_a_sigma_bound_calibrate_within_3_sigma() {
     let names = ["r_L", "r_R", "b", "l_x", "l_y", "l_theta"];
     for seed in [101, 104, 106] {
-        let mut config = SimConfig::preset("neato-lds").unwrap();
-        config.seed = seed;
-        config.duration = 120.0;
-        let world = World::preset(&config.world).unwrap();
-        let run = simulate_in(&config, &world).unwrap();
-        let truth = odocal_geom::FlatParams::from(config.robot).to_array();
         // The verdicts are not what is tested (a 120 s log of a sparse laser leaves
         // some parameters weak): the numbers and their σ are.
-        let opts = Options {
-            accept_weak: true,
-            ..Options::default()
-        };
-        let outcome = calibrate_log(&run.to_log(), &opts, &NoProgress)
-            .unwrap_or_else(|e| panic!("seed {seed} refused: {e}"));
+        let (outcome, truth) = calibrated(seed, 120.0);
         let e = Estimate::of(&outcome);
         for (i, name) in names.iter().enumerate() {
             let err = e.params[i] - truth[i];
@@ -56,17 +65,7 @@ fn neato_logs_refused_under_a_sigma_bound_calibrate_within_3_sigma() {
 #[test]
 fn clouds_placed_by_a_poor_first_estimate_do_not_make_a_confident_wrong_b() {
     let names = ["r_L", "r_R", "b", "l_x", "l_y", "l_theta"];
-    let mut config = SimConfig::preset("neato-lds").unwrap();
-    config.seed = 208;
-    config.duration = 40.0;
-    let world = World::preset(&config.world).unwrap();
-    let run = simulate_in(&config, &world).unwrap();
-    let truth = odocal_geom::FlatParams::from(config.robot).to_array();
-    let opts = Options {
-        accept_weak: true,
-        ..Options::default()
-    };
-    let outcome = calibrate_log(&run.to_log(), &opts, &NoProgress).unwrap();
+    let (outcome, truth) = calibrated(208, 40.0);
     assert!(
         outcome.synced.samples.iter().any(|s| s.icp.neighbours > 0),
         "no pair matched with its neighbouring scans: the case is gone"

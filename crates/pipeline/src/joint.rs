@@ -707,34 +707,29 @@ fn merged(outcomes: &[&Outcome]) -> Synchronized {
         sweep_compensated: outcomes.iter().any(|o| o.synced.sweep_compensated),
         read_time_sigma: None,
         // One log's unrepaired timing weakens the joint verdicts too.
-        unrepaired_timing: {
-            let causes: Vec<&str> = outcomes
-                .iter()
-                .filter_map(|o| o.synced.unrepaired_timing.as_deref())
-                .collect();
-            (!causes.is_empty()).then(|| causes.join("; "))
-        },
-        heading_not_from_wheels: {
-            let causes: Vec<&str> = outcomes
-                .iter()
-                .filter_map(|o| o.synced.heading_not_from_wheels.as_deref())
-                .collect();
-            (!causes.is_empty()).then(|| causes.join("; "))
-        },
+        unrepaired_timing: joined_causes(outcomes, |s| &s.unrepaired_timing),
+        heading_not_from_wheels: joined_causes(outcomes, |s| &s.heading_not_from_wheels),
         // Set by the joint solve when its model cannot hold a log's slide.
         unmodelled_slide: None,
         // One log's unsettled placement weakens the joint verdicts too.
-        unsettled_placement: {
-            let causes: Vec<&str> = outcomes
-                .iter()
-                .filter_map(|o| o.synced.unsettled_placement.as_deref())
-                .collect();
-            (!causes.is_empty()).then(|| causes.join("; "))
-        },
+        unsettled_placement: joined_causes(outcomes, |s| &s.unsettled_placement),
         scan_returns: first.scan_returns,
         // Set by the joint solve when the logs are one log's phases.
         shared_error_factor: 1.0,
     }
+}
+
+/// The causes `cause` gives of the logs' verdicts not being judged, joined; `None`
+/// when no log has one.
+fn joined_causes(
+    outcomes: &[&Outcome],
+    cause: impl Fn(&Synchronized) -> &Option<String>,
+) -> Option<String> {
+    let causes: Vec<&str> = outcomes
+        .iter()
+        .filter_map(|o| cause(&o.synced).as_deref())
+        .collect();
+    (!causes.is_empty()).then(|| causes.join("; "))
 }
 
 /// The logs' scan-matching self-checks pooled: RMS errors weighted by the triples
