@@ -45,6 +45,9 @@ pub enum FindingKind {
     GyroHeading,
     /// A skid-steer robot sliding sideways in its turns (`v_y = −k·v·ω`).
     LateralSlip,
+    /// A phase of a log (`--all-pairs`) matched from first guesses by another phase's
+    /// estimate: its own pairs matched from the identity gave none.
+    PhaseGuesses,
 }
 
 impl FindingKind {
@@ -95,6 +98,7 @@ impl FindingKind {
             FindingKind::PhaseCorrelation => "phase_correlation",
             FindingKind::GyroHeading => "gyro_heading",
             FindingKind::LateralSlip => "lateral_slip",
+            FindingKind::PhaseGuesses => "phase_guesses",
         }
     }
 }

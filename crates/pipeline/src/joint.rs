@@ -20,7 +20,7 @@ use crate::self_check::MatchSelfCheck;
 use crate::sync::DiscardCounts;
 use crate::synchronized::Synchronized;
 use odocal_log::Log;
-use odocal_solver::{Calibration, LasersCalibration, Sample, SolveOptions};
+use odocal_solver::{Calibration, LasersCalibration, Params, Sample, SolveOptions};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -187,23 +187,49 @@ fn calibrate_joint(
 ) -> Result<JointOutcome, JointError> {
     // Numbered densely from the first log's laser, whatever numbers were given.
     let laser_of_log = crate::lasers::laser_indices(&lasers.of_log);
-    let mut outcomes = Vec::with_capacity(logs.len());
-    for (index, (name, log)) in logs.iter().enumerate() {
+    // The log's laser's first guess and constraints; its own estimate is never
+    // refused (only compared).
+    let own_options = |index: usize, initial_params: Option<Params>| {
         let k = laser_of_log.get(index).copied().unwrap_or(0);
-        // The log's laser's first guess and constraints; its own estimate is never
-        // refused (only compared).
         let mut own = Options {
             accept_weak: true,
-            initial_params: lasers.initial_params(k, opts.initial_params),
+            initial_params: lasers.initial_params(k, initial_params),
             ..opts.clone()
         };
         own.solve.constraints = lasers.constraints_of(k, &opts.solve.constraints);
-        let outcome = calibrate_log(log, &own, progress).map_err(|source| JointError::Log {
+        own
+    };
+    let mut results: Vec<Result<Outcome, PipelineError>> = logs
+        .iter()
+        .enumerate()
+        .map(|(index, (_, log))| {
+            calibrate_log(log, &own_options(index, opts.initial_params), progress)
+        })
+        .collect();
+    let mut guessed = Vec::new();
+    for index in 0..logs.len() {
+        if results[index].is_ok() || opts.initial_params.is_some() {
+            continue;
+        }
+        // A phase whose own matches from the identity gave no estimate to guess and
+        // place its pairs by: matched again from the estimate of another phase of its
+        // log (first guesses only, as a nominal would be).
+        let Some((sibling, estimate)) = sibling_estimate(groups, &results, index) else {
+            continue;
+        };
+        let retried = calibrate_log(logs[index].1, &own_options(index, Some(estimate)), progress);
+        if retried.is_ok() {
+            guessed.push((index, sibling));
+            results[index] = retried;
+        }
+    }
+    let mut outcomes = Vec::with_capacity(logs.len());
+    for (index, result) in results.into_iter().enumerate() {
+        outcomes.push(result.map_err(|source| JointError::Log {
             index,
-            name: name.to_string(),
+            name: logs[index].0.to_string(),
             source,
-        })?;
-        outcomes.push(outcome);
+        })?);
     }
     let t = Instant::now();
     let mut health: Vec<Finding> = logs
@@ -216,6 +242,17 @@ fn calibrate_joint(
             })
         })
         .collect();
+    health.extend(guessed.iter().map(|&(index, sibling)| {
+        Finding::note(
+            FindingKind::PhaseGuesses,
+            format!(
+                "{}: its pairs matched from the identity gave no estimate to guess and place \
+                 its pairs by; matched from first guesses by the estimate of {} (first \
+                 guesses only: its samples are its own)",
+                logs[index].0, logs[sibling].0
+            ),
+        )
+    }));
     let all: Vec<&Outcome> = outcomes.iter().collect();
     let Together {
         samples,
@@ -717,6 +754,26 @@ fn merged(outcomes: &[&Outcome]) -> Synchronized {
         // Set by the joint solve when the logs are one log's phases.
         shared_error_factor: 1.0,
     }
+}
+
+/// For the log at `index`, a phase of a log of `groups`: another phase of that log
+/// that calibrated (`results`), and its estimate; `None` when `index` is no phase or
+/// no other phase of its log calibrated.
+fn sibling_estimate(
+    groups: &[LogPhases],
+    results: &[Result<Outcome, PipelineError>],
+    index: usize,
+) -> Option<(usize, Params)> {
+    let group = groups
+        .iter()
+        .find(|g| g.logs.len() > 1 && g.logs.contains(&index))?;
+    group
+        .logs
+        .iter()
+        .find_map(|&other| match results.get(other)? {
+            Ok(outcome) if other != index => Some((other, outcome.calibration.params)),
+            _ => None,
+        })
 }
 
 /// The causes `cause` gives of the logs' verdicts not being judged, joined; `None`
