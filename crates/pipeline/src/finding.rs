@@ -46,7 +46,7 @@ pub enum FindingKind {
     /// A skid-steer robot sliding sideways in its turns (`v_y = −k·v·ω`).
     LateralSlip,
     /// A phase of a log (`--all-pairs`) matched from first guesses by another phase's
-    /// estimate: its own pairs matched from the identity gave none.
+    /// estimate: too few of its pairs matched from its own.
     PhaseGuesses,
 }
 

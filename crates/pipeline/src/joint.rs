@@ -208,12 +208,14 @@ fn calibrate_joint(
         .collect();
     let mut guessed = Vec::new();
     for index in 0..logs.len() {
-        if results[index].is_ok() || opts.initial_params.is_some() {
+        let too_few = matches!(results[index], Err(PipelineError::TooFewSamples { .. }));
+        if !too_few || opts.initial_params.is_some() {
             continue;
         }
-        // A phase whose own matches from the identity gave no estimate to guess and
-        // place its pairs by: matched again from the estimate of another phase of its
-        // log (first guesses only, as a nominal would be).
+        // A phase with too few samples from its own first guesses (its pairs matched
+        // from the identity gave no estimate, or a poor one, to guess and place the
+        // others by): matched again from the estimate of another phase of its log
+        // (first guesses only, as a nominal would be).
         let Some((sibling, estimate)) = sibling_estimate(groups, &results, index) else {
             continue;
         };
@@ -246,9 +248,10 @@ fn calibrate_joint(
         Finding::note(
             FindingKind::PhaseGuesses,
             format!(
-                "{}: its pairs matched from the identity gave no estimate to guess and place \
-                 its pairs by; matched from first guesses by the estimate of {} (first \
-                 guesses only: its samples are its own)",
+                "{}: too few of its pairs matched from its own first guesses (those from \
+                 the identity gave no estimate, or a poor one, to guess and place the others \
+                 by); matched again from first guesses by the estimate of {} (first guesses \
+                 only: its samples are its own)",
                 logs[index].0, logs[sibling].0
             ),
         )
