@@ -199,23 +199,34 @@ fn calibrate_joint(
         own.solve.constraints = lasers.constraints_of(k, &opts.solve.constraints);
         own
     };
-    let mut results: Vec<Result<Outcome, PipelineError>> = logs
-        .iter()
-        .enumerate()
-        .map(|(index, (_, log))| {
-            calibrate_log(log, &own_options(index, opts.initial_params), progress)
-        })
-        .collect();
+    let failed = |index: usize, source: PipelineError| JointError::Log {
+        index,
+        name: logs[index].0.to_string(),
+        source,
+    };
+    // A phase with too few samples from its own first guesses (its pairs matched from
+    // the identity gave no estimate, or a poor one, to guess and place the others by)
+    // waits for another phase of its log; any other failure stops the run at once.
+    let mut results: Vec<Result<Outcome, PipelineError>> = Vec::with_capacity(logs.len());
+    for (index, (_, log)) in logs.iter().enumerate() {
+        let result = calibrate_log(log, &own_options(index, opts.initial_params), progress);
+        match result {
+            Err(e @ PipelineError::TooFewSamples { .. })
+                if opts.initial_params.is_none() && in_phases(groups, index) =>
+            {
+                results.push(Err(e))
+            }
+            Err(e) => return Err(failed(index, e)),
+            Ok(outcome) => results.push(Ok(outcome)),
+        }
+    }
+    // Such a phase is matched again from the estimate of another phase of its log
+    // (first guesses only, as a nominal would be).
     let mut guessed = Vec::new();
     for index in 0..logs.len() {
-        let too_few = matches!(results[index], Err(PipelineError::TooFewSamples { .. }));
-        if !too_few || opts.initial_params.is_some() {
+        if results[index].is_ok() {
             continue;
         }
-        // A phase with too few samples from its own first guesses (its pairs matched
-        // from the identity gave no estimate, or a poor one, to guess and place the
-        // others by): matched again from the estimate of another phase of its log
-        // (first guesses only, as a nominal would be).
         let Some((sibling, estimate)) = sibling_estimate(groups, &results, index) else {
             continue;
         };
@@ -227,11 +238,7 @@ fn calibrate_joint(
     }
     let mut outcomes = Vec::with_capacity(logs.len());
     for (index, result) in results.into_iter().enumerate() {
-        outcomes.push(result.map_err(|source| JointError::Log {
-            index,
-            name: logs[index].0.to_string(),
-            source,
-        })?);
+        outcomes.push(result.map_err(|source| failed(index, source))?);
     }
     let t = Instant::now();
     let mut health: Vec<Finding> = logs
@@ -759,6 +766,18 @@ fn merged(outcomes: &[&Outcome]) -> Synchronized {
     }
 }
 
+/// The log of `groups` of which the log at `index` is one of several phases.
+fn phases_of(groups: &[LogPhases], index: usize) -> Option<&LogPhases> {
+    groups
+        .iter()
+        .find(|g| g.logs.len() > 1 && g.logs.contains(&index))
+}
+
+/// Whether the log at `index` is one of several phases of a log of `groups`.
+fn in_phases(groups: &[LogPhases], index: usize) -> bool {
+    phases_of(groups, index).is_some()
+}
+
 /// For the log at `index`, a phase of a log of `groups`: another phase of that log
 /// that calibrated (`results`), and its estimate; `None` when `index` is no phase or
 /// no other phase of its log calibrated.
@@ -767,10 +786,7 @@ fn sibling_estimate(
     results: &[Result<Outcome, PipelineError>],
     index: usize,
 ) -> Option<(usize, Params)> {
-    let group = groups
-        .iter()
-        .find(|g| g.logs.len() > 1 && g.logs.contains(&index))?;
-    group
+    phases_of(groups, index)?
         .logs
         .iter()
         .find_map(|&other| match results.get(other)? {

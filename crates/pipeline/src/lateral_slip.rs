@@ -246,17 +246,16 @@ pub fn finding(calibration: &Calibration, model: SlideModel) -> Option<Finding> 
             )
         });
     }
-    (slip.significance() > SIGNIFICANCE && slip.k < 0.0).then(|| {
-        Finding::warning(
-            FindingKind::LateralSlip,
-            format!(
-                "the lateral residuals grow with v·ω inward of the turns ({numbers}): no \
-                 wheel slides that way, so it is not estimated; {shift}, likely from \
-                 another cause (laser timing, a mis-scaled range); `--lateral-slip` \
-                 estimates it anyway"
-            ),
-        )
-    })
+    // Significant and inward of the turns.
+    Some(Finding::warning(
+        FindingKind::LateralSlip,
+        format!(
+            "the lateral residuals grow with v·ω inward of the turns ({numbers}): no \
+             wheel slides that way, so it is not estimated; {shift}, likely from another \
+             cause (laser timing, a mis-scaled range); `--lateral-slip` estimates it \
+             anyway"
+        ),
+    ))
 }
 
 #[cfg(test)]
