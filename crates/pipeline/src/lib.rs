@@ -33,6 +33,7 @@
 
 pub mod atomic_dir;
 pub mod atomic_file;
+pub mod bootstrap_runs;
 pub mod chained;
 pub mod consistency;
 mod error;

@@ -201,6 +201,55 @@ fn scan_place(s: &odocal_log::ScanRef<'_>) -> String {
     }
 }
 
+/// Scan `i` of `scans` prepared for matching ([`prepare_scan`]), or the failure its
+/// pairs report: where the scan is in its source and why it could not be prepared.
+pub(crate) fn prepared_or_failure(
+    scans: &ScanStore,
+    rays: &[RayDirections],
+    i: usize,
+    params: &IcpParams,
+) -> Result<PreparedScan, MatchFailure> {
+    match prepare_scan(scans, rays, i, params) {
+        Some(Ok(scan)) => Ok(scan),
+        Some(Err(e)) => {
+            let place = scans.get(i).map(|s| scan_place(&s)).unwrap_or_default();
+            Err(MatchFailure::new(
+                Rejection::of(&e),
+                format!("scan {i} ({place}): {e}"),
+            ))
+        }
+        None => Err(MatchFailure::new(
+            Rejection::Scan,
+            format!("scan {i} does not exist"),
+        )),
+    }
+}
+
+/// One pair of prepared scans matched from `guess`: its statistics, or why it was
+/// refused (a scan that could not be prepared, the matcher's error, or a result
+/// that does not constrain the displacement).
+pub(crate) fn match_prepared(
+    matcher: &mut Matcher,
+    reference: &Result<PreparedScan, MatchFailure>,
+    current: &Result<PreparedScan, MatchFailure>,
+    guess: Pose2,
+) -> Result<MatchStats, MatchFailure> {
+    let (reference, current) = match (reference, current) {
+        (Ok(r), Ok(c)) => (r, c),
+        (Err(e), _) | (_, Err(e)) => return Err(e.clone()),
+    };
+    let r = matcher
+        .match_scans(reference, current, guess)
+        .map_err(|e| MatchFailure::new(Rejection::of(&e), e.to_string()))?;
+    if r.ill_conditioned {
+        return Err(MatchFailure::new(
+            Rejection::Conditioning,
+            "the scans do not constrain the displacement (ill-conditioned)",
+        ));
+    }
+    Ok(MatchStats::of(&r))
+}
+
 /// Matches the pairs `(first, second)` of scan indices, each with its first guess,
 /// in parallel (rayon's current pool). Results come back in pair order and do not
 /// depend on the number of threads. `done` is called once per pair (progress).
@@ -221,39 +270,12 @@ pub fn match_pairs(
         params = &own_params;
     }
     let rays = store_rays(scans);
-    let prepare = |i: usize| match prepare_scan(scans, &rays, i, params) {
-        Some(Ok(scan)) => Ok(scan),
-        Some(Err(e)) => {
-            let place = scans.get(i).map(|s| scan_place(&s)).unwrap_or_default();
-            Err(MatchFailure::new(
-                Rejection::of(&e),
-                format!("scan {i} ({place}): {e}"),
-            ))
-        }
-        None => Err(MatchFailure::new(
-            Rejection::Scan,
-            format!("scan {i} does not exist"),
-        )),
-    };
     match_chain(
         pairs,
-        prepare,
+        |i| prepared_or_failure(scans, &rays, i, params),
         || Matcher::new(params.clone()),
         |matcher, k, reference, current| {
-            let (reference, current) = match (reference, current) {
-                (Ok(r), Ok(c)) => (r, c),
-                (Err(e), _) | (_, Err(e)) => return Err(e.clone()),
-            };
-            let r = matcher
-                .match_scans(reference, current, first_guesses[k])
-                .map_err(|e| MatchFailure::new(Rejection::of(&e), e.to_string()))?;
-            if r.ill_conditioned {
-                return Err(MatchFailure::new(
-                    Rejection::Conditioning,
-                    "the scans do not constrain the displacement (ill-conditioned)",
-                ));
-            }
-            Ok(MatchStats::of(&r))
+            match_prepared(matcher, reference, current, first_guesses[k])
         },
         done,
     )

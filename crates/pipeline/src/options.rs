@@ -5,9 +5,10 @@ use crate::sync::SyncLimits;
 use odocal_icp::IcpParams;
 use odocal_solver::{Params, SolveOptions};
 
-/// Pairs matched with identity first guesses to bootstrap the odometry guesses of
-/// the others when there are at least twice as many pairs (with fewer, all pairs are
-/// matched from identity first, and the failures again from odometry).
+/// Pairs matched without odometry (the motion the pair before measured, or the
+/// identity: [`crate::bootstrap_runs`]) to bootstrap the odometry guesses of the
+/// others when there are at least twice as many pairs (with fewer, all pairs are
+/// matched so first, and the failures again from odometry).
 pub const BOOTSTRAP_PAIRS: usize = 300;
 
 /// Consecutive pairs in each run of the bootstrap's subset of a long log: a run of
@@ -49,7 +50,7 @@ pub struct Options {
     /// Parameters for the first guesses of scan matching (odometry prediction).
     pub initial_params: Option<Params>,
     /// Without `initial_params`: match [`BOOTSTRAP_PAIRS`] evenly spread pairs (all
-    /// pairs of a shorter log) with identity guesses, solve roughly, and guess the
+    /// pairs of a shorter log) without odometry, solve roughly, and guess the
     /// other pairs and the failed ones by odometry with that estimate (fewer ICP
     /// iterations and failures). Off: identity for all.
     pub bootstrap_guesses: bool,

@@ -1,5 +1,6 @@
 //! The whole pipeline: synchronize, match, (estimate the clock offset,) solve.
 
+use crate::bootstrap_runs::{match_runs, BootstrapPair};
 use crate::chained::{rescue_refused, LinkSource};
 use crate::consistency::{check_halves, Consistency};
 use crate::error::PipelineError;
@@ -68,7 +69,7 @@ pub struct Outcome {
     pub range_scale: crate::RangeScale,
 }
 
-/// The indices of the pairs the bootstrap matches from identity guesses, of `kept`
+/// The indices of the pairs the bootstrap matches without odometry, of `kept`
 /// pairs: all of them when there are fewer than twice [`BOOTSTRAP_PAIRS`]; otherwise
 /// runs of [`BOOTSTRAP_RUN`] consecutive pairs spread evenly over the log, one run in
 /// every `kept / BOOTSTRAP_PAIRS`, so that both the subset and the pairs left are
@@ -195,27 +196,34 @@ pub fn synchronize_and_match(
     let log_noise = typical_scan_noise(&log.scans, &matcher);
     let log_icp = with_typical_noise(&matcher, log_noise.range_sigma_m);
     if guess_params.is_none() && bootstrap {
-        // Match a subset with identity guesses (an evenly spread one of long logs,
-        // every pair of short ones), solve roughly, and guess the rest — and the
-        // subset's failures — by odometry with that estimate (with a sweep:
-        // compensate with it too).
+        // Match a subset without odometry (an evenly spread one of long logs, every
+        // pair of short ones; each pair guessed by the motion the pair before it
+        // measured, or the identity: crate::bootstrap_runs), solve roughly, and guess
+        // the rest — and the subset's failures — by odometry with that estimate (with
+        // a sweep: compensate with it too).
         let subset = bootstrap_subset(kept.len());
-        let sub_pairs: Vec<(usize, usize)> = subset.iter().map(|&i| index_pairs[i]).collect();
-        let identity = vec![Pose2::IDENTITY; subset.len()];
-        // A match that leaves a direction free keeps its guess there, here the
-        // identity: refused, so that it is matched again from the odometry guess.
-        let results: Vec<_> = match_pairs(&log.scans, &sub_pairs, &identity, &log_icp, || {
-            progress.advance()
-        })
-        .into_iter()
-        .map(|r| match r {
-            Ok(m) if !m.fixes_every_direction() => Err(MatchFailure::new(
-                Rejection::Conditioning,
-                "the scans do not constrain the displacement from an identity guess",
-            )),
-            other => other,
-        })
-        .collect();
+        let sub_pairs: Vec<BootstrapPair> = subset
+            .iter()
+            .map(|&i| BootstrapPair {
+                kept: i,
+                first: index_pairs[i].0,
+                second: index_pairs[i].1,
+                wheels: [kept[i].1.dphi_l, kept[i].1.dphi_r],
+            })
+            .collect();
+        // A match that leaves a direction free keeps its guess there (the identity,
+        // or the previous pair's motion): refused, so that it is matched again from
+        // the odometry guess.
+        let results: Vec<_> = match_runs(&log.scans, &sub_pairs, &log_icp, || progress.advance())
+            .into_iter()
+            .map(|r| match r {
+                Ok(m) if !m.fixes_every_direction() => Err(MatchFailure::new(
+                    Rejection::Conditioning,
+                    "the scans do not constrain the displacement from a guess without odometry",
+                )),
+                other => other,
+            })
+            .collect();
         let samples: Vec<_> = subset
             .iter()
             .zip(&results)
