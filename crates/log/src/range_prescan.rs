@@ -19,6 +19,10 @@ use std::ops::Range;
 /// accuracy, remission_mode); FLASER lines have none.
 const LASER_HEADER_TOKENS: usize = 7;
 
+/// Pieces of a batch per thread: the thread that handles the lines in order takes
+/// the pieces left when it is done, so the pieces must be small enough to share.
+const PIECES_PER_THREAD: usize = 4;
+
 /// One line's readings parsed ahead.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Ready<'a> {
@@ -66,8 +70,8 @@ pub(crate) fn prescan(batch: &LineBatch) -> Prescan {
     if threads < 2 || batch.lines.len() < 2 {
         return Prescan::default();
     }
-    // Pieces of about equal bytes, one per thread.
-    let share = batch.text.len() / threads + 1;
+    // Pieces of about equal bytes, a few per thread.
+    let share = batch.text.len() / (PIECES_PER_THREAD * threads) + 1;
     let mut cuts = vec![0];
     for (k, (bytes, _)) in batch.lines.iter().enumerate() {
         if bytes.start >= share * cuts.len() {
