@@ -712,13 +712,15 @@ pub fn calibrate_log(
     if let Some(range) = opts.estimate_time_offset {
         crate::time_offset::checked_range(range, scan_span(log), true)?;
     }
-    let mut synced = synchronize_and_match(log, opts, progress, &mut timing)
-        .map_err(|e| PipelineError::with_faults(e, &findings))?;
+    // The scans' jitter is judged beside the matching (a few ms on one thread that the
+    // matching's threads absorb).
+    let (synced, jitter) = rayon::join(
+        || synchronize_and_match(log, opts, progress, &mut timing),
+        || health::scan_jitter::estimate(&log.scans.scans, &log.encoders, opts.time_offset),
+    );
+    let mut synced = synced.map_err(|e| PipelineError::with_faults(e, &findings))?;
     synced.read_time_sigma = read_time_sigma;
-    if let Some(j) =
-        health::scan_jitter::estimate(&log.scans.scans, &log.encoders, opts.time_offset)
-            .filter(|j| j.detected())
-    {
+    if let Some(j) = jitter.filter(|j| j.detected()) {
         findings.push(j.finding());
         synced.unrepaired_timing = Some(j.cause());
     }
