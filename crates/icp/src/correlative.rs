@@ -77,21 +77,22 @@ pub(crate) fn search(
                 ys[i] = r[1] + (centre.y + d);
                 rows[i] = grid.row(ys[i]);
             }
-            for (i, column) in columns.iter().enumerate() {
-                let Some(column) = *column else { continue };
-                for (j, row) in rows.iter().enumerate() {
-                    let Some(row) = *row else { continue };
+            // Row by row, so that the lookups of one row walk along the grid's memory.
+            for (j, row) in rows.iter().enumerate() {
+                let Some(row) = *row else { continue };
+                for (i, column) in columns.iter().enumerate() {
+                    let Some(column) = *column else { continue };
                     if let Some(n) = grid.at(column, row) {
                         let p = reference[n];
                         let d2 = (xs[i] - p[0]).powi(2) + (ys[j] - p[1]).powi(2);
-                        scores[i * side + j] += (1.0 - d2 * inv_g2).max(0.0);
+                        scores[j * side + i] += (1.0 - d2 * inv_g2).max(0.0);
                     }
                 }
             }
         }
         for (i, di) in offsets.iter().enumerate() {
             for (j, dj) in offsets.iter().enumerate() {
-                let score = scores[i * side + j];
+                let score = scores[j * side + i];
                 if score > 0.0 {
                     all.push(Candidate {
                         pose: Pose2::new(centre.x + di, centre.y + dj, theta),
