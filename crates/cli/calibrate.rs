@@ -110,7 +110,9 @@ pub struct Args {
     #[arg(long, value_name = "S", value_parser = positive_seconds)]
     pub time_offset_range: Option<f64>,
     /// Identity first guesses for every scan pair (default: odometry with a rough
-    /// estimate from 300 evenly spread pairs, when the log has at least 600).
+    /// estimate from 300 evenly spread pairs, when the log has at least 600, or from
+    /// every pair, each pair of those guessed by the motion the pair before it
+    /// measured).
     #[arg(long)]
     pub identity_guess: bool,
     /// Match the scans a second time, with first guesses from the first estimate.

@@ -27,11 +27,11 @@ use odocal_log::ScanStore;
 use rayon::prelude::*;
 use std::ops::Range;
 
-/// A share of the previous pair's wheel rotation the next pair must repeat, at
-/// least, for the previous displacement to guess it: the cosine of the angle between
-/// the two pairs' `(Δφ_L, Δφ_R)`. Below it (a spin after a straight, a stop) the
-/// motion changed shape and the identity is the guess.
-pub const MIN_REPEATED_SHARE: f64 = 0.9;
+/// Smallest cosine of the angle between two consecutive pairs' wheel rotations
+/// `(Δφ_L, Δφ_R)` for the first pair's displacement to guess the second's. Below it
+/// (a spin after a straight, a reversal) the motion changed shape and the identity
+/// is the guess.
+pub const MIN_SAME_MOTION_COSINE: f64 = 0.9;
 
 /// Largest ratio of the next pair's wheel rotation to the previous pair's that the
 /// previous displacement is scaled by; beyond it the identity is the guess.
@@ -55,11 +55,11 @@ pub struct BootstrapPair {
 /// `previous` measured over the pair before it, whose wheels turned `by`: `previous`
 /// scaled by the projection of `next` on `by`; `None` (the identity is the guess)
 /// when the wheels did not turn before, or turned differently
-/// ([`MIN_REPEATED_SHARE`], [`MAX_SCALE`]).
+/// ([`MIN_SAME_MOTION_COSINE`], [`MAX_SCALE`]).
 pub fn predicted(previous: &Pose2, by: [f64; 2], next: [f64; 2]) -> Option<Pose2> {
     let dot = by[0] * next[0] + by[1] * next[1];
     let (n_by, n_next) = (by[0].hypot(by[1]), next[0].hypot(next[1]));
-    if !(n_by > 0.0 && n_next > 0.0) || dot < MIN_REPEATED_SHARE * n_by * n_next {
+    if !(n_by > 0.0 && n_next > 0.0) || dot < MIN_SAME_MOTION_COSINE * n_by * n_next {
         return None;
     }
     let scale = dot / (n_by * n_by);

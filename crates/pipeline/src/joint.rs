@@ -204,8 +204,8 @@ fn calibrate_joint(
         name: logs[index].0.to_string(),
         source,
     };
-    // A phase with too few samples from its own first guesses (its pairs matched from
-    // the identity gave no estimate, or a poor one, to guess and place the others by)
+    // A phase with too few samples from its own first guesses (its pairs matched
+    // without odometry gave no estimate, or a poor one, to guess and place the others by)
     // waits for another phase of its log; any other failure stops the run at once.
     let mut results: Vec<Result<Outcome, PipelineError>> = Vec::with_capacity(logs.len());
     for (index, (_, log)) in logs.iter().enumerate() {
@@ -255,9 +255,9 @@ fn calibrate_joint(
         Finding::note(
             FindingKind::PhaseGuesses,
             format!(
-                "{}: too few of its pairs matched from its own first guesses (those from \
-                 the identity gave no estimate, or a poor one, to guess and place the others \
-                 by); matched again from first guesses by the estimate of {} (first guesses \
+                "{}: too few of its pairs matched from its own first guesses (those matched \
+                 without odometry gave no estimate, or a poor one, to guess and place the \
+                 others by); matched again from first guesses by the estimate of {} (first guesses \
                  only: its samples are its own)",
                 logs[index].0, logs[sibling].0
             ),
