@@ -158,7 +158,7 @@ mod tests {
             prop_assert_eq!(bits(&got), bits(&want));
         }
 
-        /// The keys order as `f64::total_cmp` does, on any bit patterns.
+        /// The keys order as `f32::total_cmp` does, on any bit patterns.
         #[test]
         fn keys_order_as_total_cmp(a in any::<u32>(), b in any::<u32>()) {
             let (x, y) = (f32::from_bits(a), f32::from_bits(b));

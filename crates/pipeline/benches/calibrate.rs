@@ -1,11 +1,15 @@
 //! Pipeline speed on a simulated 2-minute Khepera log (1,200 URG-04LX scans, 300
 //! samples at the default stride): synchronization alone, synchronization + matching,
-//! and the whole calibration (sync, matching, trimming, refinement, covariance), on
-//! rayon's default pool. The one-hour-log figure in docs/benchmarks.md is measured
+//! the bootstrap's matching of every pair without a nominal (runs guessed by the
+//! motion before, against every pair from the identity), and the whole calibration
+//! (sync, matching, trimming, refinement, covariance), on rayon's default pool. The one-hour-log figure in docs/benchmarks.md is measured
 //! with the binary (see there).
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use odocal_geom::Pose2;
 use odocal_log::{read_carmen_from, Log, ReadOptions};
+use odocal_pipeline::bootstrap_runs::{match_runs, BootstrapPair};
+use odocal_pipeline::matching::{match_pairs, typical_noise_sigma, with_typical_noise};
 use odocal_pipeline::sync::{default_stride, scan_pairs, EncoderTrack, SyncLimits};
 use odocal_pipeline::{calibrate_log, synchronize_and_match, NoProgress, Options, Timing};
 use odocal_sim::{simulate, SimConfig};
@@ -46,6 +50,19 @@ fn pipeline(c: &mut Criterion) {
             let s = synchronize_and_match(&log, &opts, &NoProgress, &mut timing).expect("ok");
             black_box(s.samples.len())
         })
+    });
+    let mut timing = Timing::default();
+    let synced = synchronize_and_match(&log, &opts, &NoProgress, &mut timing).expect("ok");
+    let pairs = BootstrapPair::of_samples(&synced.samples);
+    let ends: Vec<(usize, usize)> = pairs.iter().map(|p| (p.first, p.second)).collect();
+    let matcher = opts.icp_for(&log);
+    let icp = with_typical_noise(&matcher, typical_noise_sigma(&log.scans, &matcher));
+    group.bench_function("bootstrap_runs", |b| {
+        b.iter(|| black_box(match_runs(&log.scans, &pairs, &icp, || ()).len()))
+    });
+    group.bench_function("bootstrap_identity", |b| {
+        let identity = vec![Pose2::IDENTITY; ends.len()];
+        b.iter(|| black_box(match_pairs(&log.scans, &ends, &identity, &icp, || ()).len()))
     });
     group.bench_function("calibrate", |b| {
         b.iter(|| {

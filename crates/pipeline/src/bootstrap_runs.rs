@@ -51,6 +51,23 @@ pub struct BootstrapPair {
     pub wheels: [f64; 2],
 }
 
+impl BootstrapPair {
+    /// Synchronized samples as bootstrap pairs, the kept index being each one's
+    /// position (to match a log's pairs again as the bootstrap would: benches, tests).
+    pub fn of_samples(samples: &[crate::samples::PairSample]) -> Vec<BootstrapPair> {
+        samples
+            .iter()
+            .enumerate()
+            .map(|(k, s)| BootstrapPair {
+                kept: k,
+                first: s.pair.first,
+                second: s.pair.second,
+                wheels: [s.wheel.dphi_l, s.wheel.dphi_r],
+            })
+            .collect()
+    }
+}
+
 /// The guess for a pair with wheel rotations `next` from the displacement
 /// `previous` measured over the pair before it, whose wheels turned `by`: `previous`
 /// scaled by the projection of `next` on `by`; `None` (the identity is the guess)

@@ -141,17 +141,7 @@ fn bootstrap_runs_need_fewer_iterations_and_lose_no_pair() {
     let opts = Options::default();
     let mut timing = Timing::default();
     let synced = synchronize_and_match(&log, &opts, &NoProgress, &mut timing).unwrap();
-    let pairs: Vec<BootstrapPair> = synced
-        .samples
-        .iter()
-        .enumerate()
-        .map(|(k, s)| BootstrapPair {
-            kept: k,
-            first: s.pair.first,
-            second: s.pair.second,
-            wheels: [s.wheel.dphi_l, s.wheel.dphi_r],
-        })
-        .collect();
+    let pairs = BootstrapPair::of_samples(&synced.samples);
     let matcher = opts.icp_for(&log);
     let icp = with_typical_noise(&matcher, typical_noise_sigma(&log.scans, &matcher));
     let ends: Vec<(usize, usize)> = pairs.iter().map(|p| (p.first, p.second)).collect();
