@@ -1,5 +1,5 @@
 //! The bootstrap's matches without a nominal: runs of consecutive pairs, each pair
-//! guessed by the motion the last matched pair of its run measured.
+//! guessed by the motion the pair before it in its run measured.
 //!
 //! Without parameters there is no odometry to guess a pair by, and matching from the
 //! identity asks the matcher to find the whole motion: more iterations (4.1 against
@@ -7,19 +7,16 @@
 //! than it may correct (a real MinesRover at 0.6 m/s moves 24 cm between the scans of
 //! a pair). The wheels still say how the motion changes from one pair to the next:
 //! for small motions the sensor's displacement is about linear in the wheel rotations
-//! `(Δφ_L, Δφ_R)`, so a matched pair's displacement, scaled by how much of its wheel
-//! rotation a later pair of the run repeats, is a guess close to that pair's
-//! ([`predicted`]). The last matched pair guesses: after a pair that failed, the one
-//! before it (on the real MinesRover's exp1, whose pairs all bootstrap, 116 of 177
-//! pairs match, against 96 from the identity and 105 guessed by the previous pair
-//! only).
+//! `(Δφ_L, Δφ_R)`, so the previous pair's measured displacement, scaled by how much of
+//! the previous pair's wheel rotation the next pair repeats, is a guess close to the
+//! next pair's ([`predicted`]).
 //!
-//! A run's pairs until one is matched, and a pair whose wheels turned in a direction
-//! the last matched pair's did not (a turn after a straight), start from the identity
-//! as before; a pair that fails from its predicted guess is matched again from the
-//! identity, so no pair is refused that the identity would have matched. Runs are cut
-//! at fixed places (every [`BOOTSTRAP_RUN`] pairs of the kept pairs, and wherever the
-//! chain breaks), so the results do not depend on the thread count.
+//! A run's first pair, a pair after a failed one and a pair whose wheels turned in a
+//! direction the previous pair's did not (a turn after a straight) start from the
+//! identity as before; a pair that fails from its predicted guess is matched again
+//! from the identity, so no pair is refused that the identity would have matched.
+//! Runs are cut at fixed places (every [`BOOTSTRAP_RUN`] pairs of the kept pairs, and
+//! wherever the chain breaks), so the results do not depend on the thread count.
 
 use crate::matching::{match_prepared, prepared_or_failure, store_rays, MatchStats};
 use crate::options::BOOTSTRAP_RUN;
@@ -30,14 +27,14 @@ use odocal_log::ScanStore;
 use rayon::prelude::*;
 use std::ops::Range;
 
-/// Smallest cosine of the angle between two pairs' wheel rotations `(Δφ_L, Δφ_R)`
-/// for the earlier pair's displacement to guess the later one's. Below it
+/// Smallest cosine of the angle between two consecutive pairs' wheel rotations
+/// `(Δφ_L, Δφ_R)` for the first pair's displacement to guess the second's. Below it
 /// (a spin after a straight, a reversal) the motion changed shape and the identity
 /// is the guess.
 pub const MIN_SAME_MOTION_COSINE: f64 = 0.9;
 
-/// Largest ratio of a pair's wheel rotation to the earlier pair's that the earlier
-/// displacement is scaled by; beyond it the identity is the guess.
+/// Largest ratio of the next pair's wheel rotation to the previous pair's that the
+/// previous displacement is scaled by; beyond it the identity is the guess.
 pub const MAX_SCALE: f64 = 3.0;
 
 /// One bootstrap pair: its scans and its wheel rotations `(Δφ_L, Δφ_R)` (rad).
@@ -72,7 +69,7 @@ impl BootstrapPair {
 }
 
 /// The guess for a pair with wheel rotations `next` from the displacement
-/// `previous` measured over an earlier pair, whose wheels turned `by`: `previous`
+/// `previous` measured over the pair before it, whose wheels turned `by`: `previous`
 /// scaled by the projection of `next` on `by`; `None` (the identity is the guess)
 /// when the wheels did not turn before, or turned differently
 /// ([`MIN_SAME_MOTION_COSINE`], [`MAX_SCALE`]).
@@ -112,7 +109,7 @@ pub fn runs(pairs: &[BootstrapPair]) -> Vec<Range<usize>> {
 }
 
 /// Matches `pairs` run by run ([`runs`]), the runs in parallel (rayon's current
-/// pool), each pair from the guess the run's last matched pair predicts, or the
+/// pool), each pair from the guess its predecessor's result predicts, or the
 /// identity; results in the order of `pairs`. `params` must carry the log's typical
 /// noise. `done` is called once per pair.
 pub fn match_runs(
@@ -131,23 +128,20 @@ pub fn match_runs(
                 let mut out: Vec<Result<MatchStats, MatchFailure>> = Vec::with_capacity(run.len());
                 // The previous pair's current scan: this pair's reference (a run chains).
                 let mut next_reference = None;
-                // The displacement and wheel rotations of the run's last matched pair.
-                let mut last_matched: Option<(Pose2, [f64; 2])> = None;
                 for k in run {
                     let pair = &pairs[k];
                     let reference = next_reference.take().unwrap_or_else(|| prepare(pair.first));
                     let current = prepare(pair.second);
-                    let guess = last_matched
-                        .and_then(|(pose, wheels)| predicted(&pose, wheels, pair.wheels));
+                    let guess = out.last().and_then(|last| {
+                        let previous = last.as_ref().ok()?;
+                        predicted(&previous.pose, pairs[k - 1].wheels, pair.wheels)
+                    });
                     let from_guess =
                         guess.map(|g| match_prepared(matcher, &reference, &current, g));
                     let result = match from_guess {
                         Some(Ok(m)) => Ok(m),
                         _ => match_prepared(matcher, &reference, &current, Pose2::IDENTITY),
                     };
-                    if let Ok(m) = &result {
-                        last_matched = Some((m.pose, pair.wheels));
-                    }
                     out.push(result);
                     done();
                     next_reference = Some(current);
