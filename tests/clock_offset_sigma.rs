@@ -1,7 +1,8 @@
 //! The clock offset comes with a σ (from the curvature of the offset search's cost),
 //! and on a swept laser it is estimated again once the sweep is compensated at it: a
 //! TurtleBot-class log (LDS-like laser sweeping over each scan) with an 80 ms offset
-//! gives the offset within 4σ and no false slip episodes.
+//! gives the offset within 4σ, the parameters' σ holding their move when the offset
+//! moves by its σ, and no false slip episodes.
 
 mod common;
 
@@ -23,6 +24,17 @@ fn swept_log_with_an_offset_gets_it_within_its_sigma_and_no_false_slip() {
         (offset - truth_offset).abs() < 4.0 * sigma,
         "offset {offset} ± {sigma}, truth {truth_offset}"
     );
+    // Not knowing the offset exactly is in the parameters' σ: each σ holds at least
+    // the parameter's move when the offset moves by its σ.
+    let shift = v["time_offset_parameter_shift"]
+        .as_array()
+        .expect("the parameters' move per σ of the offset");
+    let sigmas = v["sigma"].as_array().expect("σ");
+    assert_eq!(shift.len(), 6);
+    for (d, s) in shift.iter().zip(sigmas) {
+        let (d, s) = (d.as_f64().expect("finite"), s.as_f64().expect("σ"));
+        assert!(d.is_finite() && d.abs() <= s, "move {d}, σ {s}");
+    }
     let slips: Vec<_> = v["health"]
         .as_array()
         .unwrap()

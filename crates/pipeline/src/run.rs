@@ -506,6 +506,17 @@ pub fn resynchronize(log: &Log, synced: &mut Synchronized, offset: f64) {
 }
 
 fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineError> {
+    solve_widened(synced, opts, None)
+}
+
+/// [`solve`], with the covariance widened by `shift · shiftᵀ` before the verdicts:
+/// how far the parameters move when the clock offset they were solved at moves by
+/// its σ ([`OffsetEstimate::parameter_shift`]).
+fn solve_widened(
+    synced: &Synchronized,
+    opts: &Options,
+    shift: Option<&[f64; 6]>,
+) -> Result<Calibration, PipelineError> {
     // Samples that leave a direction free (a corridor's) add to the others but do
     // not count toward the minimum: alone they determine less than a sample each.
     let usable = synced
@@ -552,7 +563,37 @@ fn solve(synced: &Synchronized, opts: &Options) -> Result<Calibration, PipelineE
     );
     // The matcher's own error, when larger than the residuals' noise, scales σ.
     crate::match_quality::scale_by_self_check(&mut calibration, synced.match_self_check.as_ref());
+    if let Some(shift) = shift {
+        odocal_solver::widen_along(&mut calibration, shift);
+    }
     refuse_poorly_determined(calibration, synced, &samples, &solve_options, opts)
+}
+
+/// How far the parameters move when the clock offset moves by its σ: half the
+/// difference of the estimates solved (leniently: only the values count) with the
+/// samples synchronized at `offset ± σ`. `None` without a σ or when either fails.
+///
+/// The offset is estimated from the same samples, to a σ of a few ms on real logs
+/// (the MinesRover's exp1: 2.8 ms), and the estimate solved at it moves with it: the
+/// parameters' covariance must include that, as it includes not knowing the slide.
+fn offset_parameter_shift(
+    log: &Log,
+    synced: &Synchronized,
+    estimate: &OffsetEstimate,
+    lenient: &Options,
+) -> Option<[f64; 6]> {
+    let sigma = estimate.sigma.filter(|s| s.is_finite() && *s > 0.0)?;
+    let at = |offset: f64| {
+        let mut shifted = synced.clone();
+        resynchronize(log, &mut shifted, offset);
+        solve(&shifted, lenient).ok().map(|c| c.params.to_vector())
+    };
+    let (plus, minus) = rayon::join(
+        || at(estimate.offset + sigma),
+        || at(estimate.offset - sigma),
+    );
+    let (plus, minus) = (plus?, minus?);
+    Some(std::array::from_fn(|i| 0.5 * (plus[i] - minus[i])))
 }
 
 /// The calibration, or the refusal naming the parameters it does not determine well,
@@ -827,6 +868,12 @@ pub fn calibrate_log(
     let heading = odometry_heading(&synced, opts);
     synced.heading_not_from_wheels = heading.as_ref().map(|fit| fit.cause());
     let t = Instant::now();
+    // Not knowing the offset exactly goes into the σ (and the verdicts) of the
+    // estimate solved at it.
+    if let Some(est) = offset.as_mut() {
+        est.parameter_shift = offset_parameter_shift(log, &synced, est, &lenient);
+    }
+    let shift = offset.as_ref().and_then(|est| est.parameter_shift);
     let samples: Vec<_> = synced
         .samples
         .iter()
@@ -834,7 +881,7 @@ pub fn calibrate_log(
         .collect();
     // The halves' check needs only the samples: it runs beside the final solve.
     let (calibration, consistency) = rayon::join(
-        || solve(&synced, opts),
+        || solve_widened(&synced, opts, shift.as_ref()),
         || {
             check_halves(
                 &samples,

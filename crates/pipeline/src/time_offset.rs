@@ -51,6 +51,11 @@ pub struct OffsetEstimate {
     pub sigma: Option<f64>,
     /// The coarse grid: (offset s, cost on its subsample of the samples).
     pub grid: Vec<(f64, f64)>,
+    /// How far the parameters (r_L, r_R, b, ℓx, ℓy, ℓθ) move when the offset moves by
+    /// its σ: half the difference of the estimates solved at `offset ± sigma`. Their
+    /// covariance includes it (`shift · shiftᵀ`); `None` when not measured (no σ, or
+    /// an estimate failed there).
+    pub parameter_shift: Option<[f64; 6]>,
 }
 
 /// The grid step (s) of a search over `start ± range`: [`GRID_STEP_S`], coarser when
@@ -260,6 +265,7 @@ pub fn estimate_time_offset(
         cost_at_start,
         sigma,
         grid,
+        parameter_shift: None,
     })
 }
 

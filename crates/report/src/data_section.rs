@@ -21,7 +21,7 @@ pub(crate) struct Row {
 }
 
 /// The rows, in order. `time_offset_sigma_s` is shown with `time_offset_s`.
-pub(crate) const ROWS: [Row; 29] = [
+pub(crate) const ROWS: [Row; 30] = [
     Row { key: "log_contents", label: "What the input holds", meaning: "scans and wheel records read, lines skipped (lenient mode) and messages not understood" },
     Row { key: "samples_used", label: "Samples used", meaning: "scan pairs with their wheel rotations that entered the final estimate" },
     Row { key: "samples_synchronized", label: "Samples synchronized", meaning: "scan pairs matched and given the wheel rotations between their two scans, before outliers were trimmed" },
@@ -40,6 +40,7 @@ pub(crate) const ROWS: [Row; 29] = [
     Row { key: "noise_weights", label: "Sample weights", meaning: "shaped: the typical match's σ (see the shaping), per sample shaped as the scan matcher's covariance of the sample compares with the typical match's (a spin matched through the scans between, a pair sharing few points weigh less); estimated: the scan-matching noise σ for every sample; sample_covariance: each sample's own covariance (--icp-covariance)" },
     Row { key: "noise_shaping", label: "Sample weights' shaping", meaning: "with shaped weights: the typical match's σ the samples were weighted by; per component, the share of the residuals' noise that follows the matcher's covariances (0: none, 1: as the matcher says); the level the σ of the estimate take with that blend" },
     Row { key: "time_offset_s", label: "Clock offset (laser − encoders)", meaning: "what was subtracted from the laser's timestamps to put them on the wheels' clock, with its σ" },
+    Row { key: "time_offset_parameter_shift", label: "Parameters' move per σ of the clock offset", meaning: "how far r_L, r_R, b, ℓx, ℓy, ℓθ move when the clock offset moves by its σ (half the difference of the estimates solved at the offset ± σ); the covariance and the σ include it" },
     Row { key: "cost_before", label: "Cost at the closed form", meaning: "sum of the squared residuals, each in units of its σ (χ²), at the closed-form solution" },
     Row { key: "cost_after", label: "Cost after refinement", meaning: "the same sum after the non-linear refinement (it should not be larger)" },
     Row { key: "observability", label: "Observability", meaning: "how well the motion in the log determines each parameter" },
@@ -226,7 +227,7 @@ fn lateral_slip(v: &Value) -> Markup {
 fn value(key: &str, x: &Value, all: &Value) -> Markup {
     let pointer = format!("/{}", escape_pointer(key));
     match key {
-        "closed_form" => parameter_vector(x, &pointer),
+        "closed_form" | "time_offset_parameter_shift" => parameter_vector(x, &pointer),
         "covariance" => covariance(x, &pointer, &PARAMETER_LABELS),
         "sm_sigma" => html! {
             @for (i, (name, scale, u)) in [("x", 1e3, "mm"), ("y", 1e3, "mm"), ("θ", DEG, "°")].iter().enumerate() {

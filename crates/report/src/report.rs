@@ -110,6 +110,11 @@ pub struct Report {
     /// offset search's cost, when it is convex there.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time_offset_sigma_s: Option<f64>,
+    /// How far the parameters (r_L, r_R, b, ℓx, ℓy, ℓθ) move when the clock offset
+    /// moves by its σ (half the difference of the estimates solved at the offset ± σ);
+    /// the covariance includes it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time_offset_parameter_shift: Option<[f64; 6]>,
     /// The nominal parameters given (`--nominal`), order r_L, r_R, b, ℓx, ℓy, ℓθ.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub nominal: Option<[f64; 6]>,
@@ -304,6 +309,7 @@ pub fn build_report(path: &Path, log: &Log, opts: &Options, outcome: &Outcome) -
         lateral_slip: c.lateral_slip,
         time_offset_s: outcome.offset.as_ref().map(|o| o.offset),
         time_offset_sigma_s: outcome.offset.as_ref().and_then(|o| o.sigma),
+        time_offset_parameter_shift: outcome.offset.as_ref().and_then(|o| o.parameter_shift),
         nominal: opts.initial_params.map(|p| p.to_vector()),
         nominal_laser: None,
         odometry_only: false,
@@ -594,9 +600,12 @@ impl fmt::Display for Report {
             let sigma = self
                 .time_offset_sigma_s
                 .map_or(String::new(), |s| format!(" ± {s:.4} s"));
+            let shift = self
+                .time_offset_parameter_shift
+                .map_or(String::new(), |d| format!("; {}", offset_shift_words(&d)));
             writeln!(
                 f,
-                "  clock offset (laser clock − encoder clock): {t:+.4} s{sigma}"
+                "  clock offset (laser clock − encoder clock): {t:+.4} s{sigma}{shift}"
             )?;
         }
         if let Some(c) = self.correction_factors {
@@ -633,4 +642,21 @@ impl fmt::Display for Report {
             t.parse, t.sync, t.r#match, t.time_offset, t.solve
         )
     }
+}
+
+/// The parameters' move per σ of the clock offset in words, as the σ above include it.
+fn offset_shift_words(shift: &[f64; 6]) -> String {
+    let moves = PARAMETER_NAMES
+        .iter()
+        .zip(shift)
+        .map(|(name, d)| {
+            if *name == "l_theta" {
+                format!("{name} {:.3}°", d.abs().to_degrees())
+            } else {
+                format!("{name} {:.2} mm", 1e3 * d.abs())
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ");
+    format!("an offset one σ away moves the estimate by {moves} (included in the σ above)")
 }

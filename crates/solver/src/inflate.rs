@@ -1,6 +1,7 @@
 //! Scaling a calibration's covariance when its noise model is found too small by a
 //! measurement outside the solver (the scan matcher's own error, say): the σ (the
-//! slide's too), the verdicts and the sentence follow.
+//! slide's too), the verdicts and the sentence follow; or widening it by the
+//! uncertainty of a quantity the estimate was computed at (the clock offset).
 
 use crate::calibrate::Calibration;
 
@@ -29,6 +30,25 @@ pub fn inflate_sigma_per_parameter(calibration: &mut Calibration, factors: [f64;
     if let Some(slip) = calibration.lateral_slip.as_mut() {
         slip.sigma *= factor;
         slip.covariance_with_params = slip.covariance_with_params.map(|c| c * factor * factor);
+    }
+    calibration
+        .observability
+        .rejudge(&calibration.params, &calibration.covariance);
+}
+
+/// Adds `shift · shiftᵀ` to the covariance of `calibration` and judges the parameters
+/// again: the uncertainty of a quantity the estimate was computed at (the clock
+/// offset, say), `shift` being how far the parameters (r_L, r_R, b, ℓx, ℓy, ℓθ) move
+/// when that quantity moves by its σ. Entries that are not finite count as 0.
+pub fn widen_along(calibration: &mut Calibration, shift: &[f64; 6]) {
+    let shift = shift.map(|s| if s.is_finite() { s } else { 0.0 });
+    if shift.iter().all(|&s| s == 0.0) {
+        return;
+    }
+    for (i, row) in calibration.covariance.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v += shift[i] * shift[j];
+        }
     }
     calibration
         .observability

@@ -1,18 +1,25 @@
 //! `inflate_sigma`: scaling a calibration's σ when a measurement outside the solver
 //! (the scan matcher's self-check) says its noise model is too small — the covariance,
 //! the σ, the verdicts and the sentence follow; factors of 1 or below change nothing.
+//! `widen_along`: a quantity the estimate was computed at, known to σ, adds the
+//! parameters' one-σ move to the covariance, and the verdicts follow.
 
 mod common;
 
 use common::{add_noise, exact_samples, rng, test_robot};
-use odocal_solver::{calibrate, inflate_sigma, SolveOptions, Verdict};
+use odocal_solver::{calibrate, inflate_sigma, widen_along, Calibration, SolveOptions, Verdict};
+
+/// A calibration of 300 samples of the test robot with 2 mm / 2 mrad noise.
+fn noisy_calibration(seed: u64) -> Calibration {
+    let mut r = rng(seed);
+    let mut samples = exact_samples(&mut r, &test_robot(), 300, 4);
+    add_noise(&mut r, &mut samples, [0.002, 0.002, 0.002]);
+    calibrate(&samples, &SolveOptions::default()).expect("calibrates")
+}
 
 #[test]
 fn inflating_scales_every_sigma_and_judges_again() {
-    let mut r = rng(11);
-    let mut samples = exact_samples(&mut r, &test_robot(), 300, 4);
-    add_noise(&mut r, &mut samples, [0.002, 0.002, 0.002]);
-    let c = calibrate(&samples, &SolveOptions::default()).expect("calibrates");
+    let c = noisy_calibration(11);
     assert!(
         c.observability
             .parameters
@@ -66,5 +73,50 @@ fn inflating_scales_every_sigma_and_judges_again() {
         !far.observability.sentence.starts_with("all six"),
         "{}",
         far.observability.sentence
+    );
+}
+
+#[test]
+fn widening_adds_the_shift_as_a_rank_one_term_and_judges_again() {
+    let c = noisy_calibration(12);
+
+    for nothing in [[0.0; 6], [f64::NAN; 6]] {
+        let mut same = c.clone();
+        widen_along(&mut same, &nothing);
+        assert_eq!(same, c);
+    }
+
+    // b moves by 3 of its σ and ℓx along with it: b's variance grows tenfold, ℓx's
+    // by its shift squared, and their covariance by the product; r_L is untouched.
+    let sigma_b = c.covariance[2][2].sqrt();
+    let shift = [0.0, 0.0, 3.0 * sigma_b, -0.001, 0.0, f64::INFINITY];
+    let mut wider = c.clone();
+    widen_along(&mut wider, &shift);
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1e-30);
+    assert!(close(wider.covariance[2][2], 10.0 * c.covariance[2][2]));
+    assert!(close(wider.covariance[3][3], c.covariance[3][3] + 1e-6));
+    assert!(close(
+        wider.covariance[2][3],
+        c.covariance[2][3] - 3e-3 * sigma_b
+    ));
+    assert_eq!(wider.covariance[3][2], wider.covariance[2][3]);
+    assert_eq!(wider.covariance[0], c.covariance[0]);
+    assert_eq!(wider.covariance[5], c.covariance[5]);
+    assert!(close(
+        wider.observability.parameters[2].sigma,
+        10f64.sqrt() * sigma_b
+    ));
+    assert_eq!(wider.params, c.params);
+
+    // A shift of b by a tenth of it: b is no longer well determined.
+    let mut far = c.clone();
+    widen_along(&mut far, &[0.0, 0.0, 0.1 * c.params.b, 0.0, 0.0, 0.0]);
+    assert_ne!(
+        far.observability.parameters[2].verdict,
+        Verdict::WellDetermined
+    );
+    assert_eq!(
+        far.observability.parameters[0].verdict,
+        Verdict::WellDetermined
     );
 }
