@@ -280,8 +280,12 @@ impl<'a> LogInputs<'a> {
 }
 
 /// Runs `odocal calibrate`.
-pub fn run(args: Args) -> anyhow::Result<()> {
+pub fn run(mut args: Args) -> anyhow::Result<()> {
     let started = Instant::now();
+    // The inputs' checksums go only into the outputs that record provenance: without
+    // them the summary alone is printed, and hashing would only take a core.
+    let provenance = args.out.is_some() || args.report.is_some() || args.json;
+    args.input.read.checksum = provenance;
     let input = &args.input;
     let pool = input.thread_pool()?;
     for log_path in input.paths() {
@@ -509,7 +513,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         {
             row.nominal = n.clone().map(nominal_pose);
         }
-        for ((row, path), checksum) in report.logs.iter_mut().zip(&paths).zip(&mut checksums) {
+        let rows = report.logs.iter_mut().zip(&paths).zip(&mut checksums);
+        for ((row, path), checksum) in rows.filter(|_| provenance) {
             let (sha256, bytes) = match checksum.take() {
                 Some(c) => c,
                 None => sha256_of_input(path)
@@ -532,18 +537,20 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     report.timing_s.parse = parse_s;
     report.odometry_only = odometry_only.is_some();
     report.nominal_laser = laser.map(nominal_pose);
-    let (input_sha256, input_bytes) = match checksums[0].take() {
-        Some(c) => c,
-        None => sha256_of_input(paths[0])
-            .with_context(|| format!("cannot read {} for its checksum", paths[0].display()))?,
-    };
-    report.provenance = Some(Provenance {
-        command_line: std::env::args().collect::<Vec<_>>().join(" "),
-        version: env!("CARGO_PKG_VERSION").to_string(),
-        input_sha256,
-        input_bytes,
-        wall_time_s: started.elapsed().as_secs_f64(),
-    });
+    if provenance {
+        let (input_sha256, input_bytes) = match checksums[0].take() {
+            Some(c) => c,
+            None => sha256_of_input(paths[0])
+                .with_context(|| format!("cannot read {} for its checksum", paths[0].display()))?,
+        };
+        report.provenance = Some(Provenance {
+            command_line: std::env::args().collect::<Vec<_>>().join(" "),
+            version: env!("CARGO_PKG_VERSION").to_string(),
+            input_sha256,
+            input_bytes,
+            wall_time_s: started.elapsed().as_secs_f64(),
+        });
+    }
 
     // The results are printed whatever happens to --out and --report, so they are never lost.
     // On the pool's threads: the figures are drawn on them.

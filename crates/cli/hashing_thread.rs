@@ -1,12 +1,12 @@
-//! A text log read, and its SHA-256 computed, on another thread while the log is
-//! parsed: that thread reads the input in chunks through a [`Sha256Reader`] and hands
+//! A text log read, and its SHA-256 computed (when its outputs record it), on another
+//! thread while the log is parsed: that thread reads the input in chunks through a [`Sha256Reader`] and hands
 //! them over (moved, not copied) to the parser, so neither the system's copy of the
 //! file's bytes nor hashing (≈ 0.5 ms per MB here) is on the parse's critical path. The
 //! checksum is [`Sha256Reader`]'s for the same bytes.
 
 use odocal_report::provenance::Sha256Reader;
 use std::io::{self, BufRead, Read};
-use std::sync::mpsc::{sync_channel, Receiver};
+use std::sync::mpsc::{sync_channel, Receiver, SyncSender};
 use std::thread::JoinHandle;
 
 /// Bytes read from the input at a time.
@@ -14,41 +14,43 @@ const CHUNK_BYTES: u64 = 1 << 18;
 /// Chunks read ahead of the parser at most (bounded memory: 4 MB).
 const CHUNKS_AHEAD: usize = 16;
 
+/// The SHA-256 (lower-case hex) and size in bytes of an input.
+pub type Checksum = (String, u64);
+
 /// A buffered reader of an input that another thread reads and hashes.
 pub struct HashedInput {
     chunks: Receiver<io::Result<Vec<u8>>>,
     chunk: Vec<u8>,
     pos: usize,
-    reader: Option<JoinHandle<io::Result<(String, u64)>>>,
+    reader: Option<JoinHandle<io::Result<Option<Checksum>>>>,
 }
 
 impl HashedInput {
     /// Starts the thread that reads and hashes `inner`.
     pub fn new<R: Read + Send + 'static>(inner: R) -> io::Result<Self> {
+        Self::start(inner, true)
+    }
+
+    /// Starts the thread that reads `inner` without hashing it ([`HashedInput::finish`]
+    /// then gives no checksum): for runs whose outputs record no provenance, where
+    /// hashing would only take a core from the parse.
+    pub fn unhashed<R: Read + Send + 'static>(inner: R) -> io::Result<Self> {
+        Self::start(inner, false)
+    }
+
+    fn start<R: Read + Send + 'static>(mut inner: R, hash: bool) -> io::Result<Self> {
         let (to_parser, chunks) = sync_channel(CHUNKS_AHEAD);
         let reader = std::thread::Builder::new()
             .name("read-sha256".into())
             .spawn(move || {
-                let mut hashing = Sha256Reader::new(inner);
-                loop {
-                    let mut chunk = Vec::with_capacity(CHUNK_BYTES as usize);
-                    match (&mut hashing).take(CHUNK_BYTES).read_to_end(&mut chunk) {
-                        Ok(0) => break,
-                        Ok(_) => {
-                            if to_parser.send(Ok(chunk)).is_err() {
-                                // The parser stopped (an error): the rest is not read.
-                                return Err(io::Error::other("the input was not read to its end"));
-                            }
-                        }
-                        Err(e) => {
-                            let again = io::Error::new(e.kind(), e.to_string());
-                            let _ = to_parser.send(Err(e));
-                            return Err(again);
-                        }
-                    }
+                if hash {
+                    let mut hashing = Sha256Reader::new(inner);
+                    pass_on(&mut hashing, to_parser)?;
+                    hashing.finish().map(Some)
+                } else {
+                    pass_on(&mut inner, to_parser)?;
+                    Ok(None)
                 }
-                drop(to_parser);
-                hashing.finish()
             })?;
         Ok(HashedInput {
             chunks,
@@ -59,8 +61,8 @@ impl HashedInput {
     }
 
     /// Reads the rest of the input, then returns the SHA-256 (lower-case hex) and size
-    /// of all of it, as [`Sha256Reader::finish`] does.
-    pub fn finish(mut self) -> io::Result<(String, u64)> {
+    /// of all of it, as [`Sha256Reader::finish`] does (`None` when not hashed).
+    pub fn finish(mut self) -> io::Result<Option<Checksum>> {
         loop {
             let n = self.fill_buf()?.len();
             if n == 0 {
@@ -71,6 +73,28 @@ impl HashedInput {
         match self.reader.take().map(JoinHandle::join) {
             Some(Ok(result)) => result,
             _ => Err(io::Error::other("the input's reading thread stopped")),
+        }
+    }
+}
+
+/// Reads `reader` to its end in chunks and sends them to the parser; a read error is
+/// sent too, and returned.
+fn pass_on<R: Read>(reader: &mut R, to_parser: SyncSender<io::Result<Vec<u8>>>) -> io::Result<()> {
+    loop {
+        let mut chunk = Vec::with_capacity(CHUNK_BYTES as usize);
+        match reader.take(CHUNK_BYTES).read_to_end(&mut chunk) {
+            Ok(0) => return Ok(()),
+            Ok(_) => {
+                if to_parser.send(Ok(chunk)).is_err() {
+                    // The parser stopped (an error): the rest is not read.
+                    return Err(io::Error::other("the input was not read to its end"));
+                }
+            }
+            Err(e) => {
+                let again = io::Error::new(e.kind(), e.to_string());
+                let _ = to_parser.send(Err(e));
+                return Err(again);
+            }
         }
     }
 }
@@ -145,10 +169,21 @@ mod tests {
             let mut more = vec![0u8; 600_000];
             input.read_exact(&mut more).unwrap();
             assert_eq!(more, bytes[upto..upto + 600_000]);
-            assert_eq!(input.finish().unwrap(), expected);
+            assert_eq!(input.finish().unwrap(), Some(expected.clone()));
+            // Unhashed: the same bytes, no checksum.
+            let mut input = HashedInput::unhashed(Trickle {
+                bytes: bytes.clone(),
+                at: 0,
+                step,
+            })
+            .unwrap();
+            let mut all = Vec::new();
+            input.read_to_end(&mut all).unwrap();
+            assert_eq!(all, bytes);
+            assert_eq!(input.finish().unwrap(), None);
         }
         let empty = HashedInput::new(io::empty()).unwrap().finish().unwrap();
-        assert_eq!(empty, Sha256Reader::new(&b""[..]).finish().unwrap());
+        assert_eq!(empty, Some(Sha256Reader::new(&b""[..]).finish().unwrap()));
     }
 
     #[test]
@@ -159,9 +194,13 @@ mod tests {
                 Err(io::Error::other("disk on fire"))
             }
         }
-        let mut input = HashedInput::new(Broken).unwrap();
-        let e = input.fill_buf().unwrap_err();
-        assert!(e.to_string().contains("disk on fire"));
-        assert!(input.finish().is_err());
+        for mut input in [
+            HashedInput::new(Broken).unwrap(),
+            HashedInput::unhashed(Broken).unwrap(),
+        ] {
+            let e = input.fill_buf().unwrap_err();
+            assert!(e.to_string().contains("disk on fire"));
+            assert!(input.finish().is_err());
+        }
     }
 }

@@ -47,15 +47,24 @@ pub fn is_bag_file(path: &Path) -> anyhow::Result<bool> {
 }
 
 /// Reads the Carmen or JSON log at `path` (`-`: standard input) in one pass; returns it
-/// with the SHA-256 and size of the input.
-pub fn read_text_log(path: &Path, opts: &ReadOptions) -> anyhow::Result<(Log, (String, u64))> {
+/// with the SHA-256 and size of the input when `checksum` asks for them.
+pub fn read_text_log(
+    path: &Path,
+    opts: &ReadOptions,
+    checksum: bool,
+) -> anyhow::Result<(Log, Option<(String, u64)>)> {
     let name = input_name(path);
     let source: Box<dyn Read + Send> = if is_stdin(path) {
         Box::new(io::stdin())
     } else {
         Box::new(File::open(path).map_err(|e| LogError::io(&name, e))?)
     };
-    let mut hashing = HashedInput::new(source).map_err(|e| LogError::io(&name, e))?;
+    let started = if checksum {
+        HashedInput::new(source)
+    } else {
+        HashedInput::unhashed(source)
+    };
+    let mut hashing = started.map_err(|e| LogError::io(&name, e))?;
     let mut head = Vec::new();
     (&mut hashing)
         .take(HEAD_BYTES)

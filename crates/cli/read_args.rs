@@ -51,6 +51,10 @@ pub struct ReadArgs {
     /// Skip malformed lines (counted and reported) instead of stopping at the first.
     #[arg(long)]
     pub lenient: bool,
+    /// Compute a text log's SHA-256 while reading it (for the provenance that
+    /// `calibrate` records in its outputs); not a command-line option.
+    #[arg(skip)]
+    pub checksum: bool,
 }
 
 impl ReadArgs {
@@ -165,10 +169,10 @@ impl ReadArgs {
                 self.log.display()
             );
         }
-        let (log, checksum) = read_text_log(&self.log, &self.read_options())?;
+        let (log, checksum) = read_text_log(&self.log, &self.read_options(), self.checksum)?;
         Ok(ReadInput {
             log,
-            checksum: Some(checksum),
+            checksum,
             nominal_laser: None,
             heading_sources: None,
             scan_topic: None,
@@ -215,7 +219,8 @@ pub struct ReadInput {
     /// The log (a bag's messages in the log model).
     pub log: Log,
     /// SHA-256 (hex) and size of a text log, computed on the one pass that read it
-    /// (`None` for a bag: see `sha256_of_input`).
+    /// when [`ReadArgs::checksum`] asks for it (`None` for a bag: see
+    /// `sha256_of_input`).
     pub checksum: Option<(String, u64)>,
     /// The laser's pose from a bag's static transforms, when it has them.
     pub nominal_laser: Option<NominalLaser>,
