@@ -411,6 +411,25 @@ fn calibrate_joint(
             .for_each(|v| *v *= factor * factor);
     }
     if lasers.is_none() {
+        // Each log's clock-offset uncertainty, in its own σ, carried into the joint σ
+        // (crate::joint_offsets); the logs' offsets were estimated apart.
+        let joint_covariance = calibration.covariance;
+        for o in &outcomes {
+            let moved = o
+                .offset
+                .as_ref()
+                .and_then(|e| e.parameter_shift)
+                .and_then(|d| {
+                    crate::joint_offsets::joint_shift(
+                        &joint_covariance,
+                        &o.calibration.covariance,
+                        &d,
+                    )
+                });
+            if let Some(moved) = moved {
+                odocal_solver::widen_along(&mut calibration, &moved);
+            }
+        }
         // Logs that disagree widen the joint σ to their spread: the logs given when
         // they are phases, else each log.
         let what = if phases_alike.is_empty() {

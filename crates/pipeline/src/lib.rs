@@ -43,6 +43,7 @@ pub mod guess_window;
 pub mod health;
 pub mod input_files;
 pub mod joint;
+pub mod joint_offsets;
 pub mod lasers;
 pub mod lateral_slip;
 pub mod local_map;
