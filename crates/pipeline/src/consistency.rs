@@ -411,6 +411,7 @@ mod tests {
         let check = MatchSelfCheck {
             triples: 60,
             tried: 60,
+            left_out: 0,
             xy_m: 3.0 * (0.5 * (sm[0] * sm[0] + sm[1] * sm[1])).sqrt(),
             theta_rad: 3.0 * sm[2],
             range_noise_m: 0.01,

@@ -855,6 +855,7 @@ fn pooled_self_check(outcomes: &[&Outcome]) -> Option<MatchSelfCheck> {
     Some(MatchSelfCheck {
         triples,
         tried: checks.iter().map(|c| c.tried).sum(),
+        left_out: checks.iter().map(|c| c.left_out).sum(),
         xy_m: mean_square(|c| c.xy_m),
         theta_rad: mean_square(|c| c.theta_rad),
         range_noise_m: noise[noise.len() / 2],

@@ -204,6 +204,7 @@ mod tests {
         MatchSelfCheck {
             triples: 60,
             tried: 60,
+            left_out: 0,
             xy_m,
             theta_rad,
             range_noise_m: 0.001,

@@ -32,7 +32,7 @@ pub(crate) const ROWS: [Row; 30] = [
     Row { key: "chained_matches", label: "Pairs matched through the scans between", meaning: "pairs refused when matched directly and matched as a chain of shorter matches (2 to 4) through the scans between their two; ŝ is the chain's composition" },
     Row { key: "neighbour_matches", label: "Pairs matched with their neighbouring scans", meaning: "pairs of sparse scans refused when matched alone and matched with each scan densified by the scan beyond it (the one before the first, the one after the second; the two beyond it when it has few returns), placed by odometry" },
     Row { key: "free_direction_matches", label: "Pairs matched along a corridor", meaning: "pairs of sparse scans whose match fixes the rotation and the displacement across the walls but not along them (a corridor, one wall): ŝ keeps odometry's first guess there, and the calibration gives that direction no weight" },
-    Row { key: "match_self_check", label: "Scan-matching self-check", meaning: "the matcher's own error, from the closure of consecutive scan triples (a lower bound)" },
+    Row { key: "match_self_check", label: "Scan-matching self-check", meaning: "the matcher's own error, from the closure of consecutive scan triples (a lower bound); closures far beyond the typical one are left out, as the solver leaves out samples" },
     Row { key: "stride", label: "Stride", meaning: "scans from the first to the second scan of a pair" },
     Row { key: "interval_s", label: "Pair interval", meaning: "target time (s) between the two scans of a pair" },
     Row { key: "ticks_per_revolution", label: "Encoder ticks per wheel turn", meaning: "wheel counts per revolution (wheel angles of a bag or of odometry are counted in 2²⁰ ticks per turn by convention)" },
@@ -195,7 +195,11 @@ fn self_check(v: &Value) -> Markup {
     html! {
         p {
             (json(&v["triples"], &format!("{p}/triples"))) " of " (json(&v["tried"], &format!("{p}/tried")))
-            " scan triples closed; one match's error: "
+            " scan triples closed"
+            @if v["left_out"].as_u64().is_some_and(|n| n > 0) {
+                " (" (json(&v["left_out"], &format!("{p}/left_out"))) " more left out as outliers)"
+            }
+            "; one match's error: "
             @if let Some(x) = v["xy_m"].as_f64() { (num(&format!("{p}/xy_m"), x, 1e3, 3)) " mm" }
             @if let Some(x) = v["theta_rad"].as_f64() { ", " (num(&format!("{p}/theta_rad"), x, DEG, 4)) "°" }
             @if let Some(x) = v["range_noise_m"].as_f64() { "; the laser's range noise: " (num(&format!("{p}/range_noise_m"), x, 1e3, 2)) " mm" }

@@ -525,10 +525,14 @@ impl fmt::Display for Report {
             };
             writeln!(
                 f,
-                "  scan matching on this log: {:.2} mm / {:.3}° per pair{ratio} (closure of {} scan triples: a lower bound, errors shared between matches of one scan do not show)",
+                "  scan matching on this log: {:.2} mm / {:.3}° per pair{ratio} (closure of {} scan triples{}: a lower bound, errors shared between matches of one scan do not show)",
                 c.xy_m * 1e3,
                 c.theta_rad.to_degrees(),
-                c.triples
+                c.triples,
+                match c.left_out {
+                    0 => String::new(),
+                    n => format!(", {n} more left out as outliers, as the solver leaves out samples"),
+                }
             )?;
         }
         writeln!(

@@ -106,4 +106,4 @@ pub use refine::Refinement;
 pub use sample::{ProfileSegment, Sample};
 pub use shared_scans::{SharedScanNoise, MIN_SHARED_SCANS};
 pub use slide_kinematics::residuals_with_slide;
-pub use trimming::Trim;
+pub use trimming::{Trim, CHI2_3DOF_9999};
