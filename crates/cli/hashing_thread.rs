@@ -41,7 +41,7 @@ impl HashedInput {
     fn start<R: Read + Send + 'static>(mut inner: R, hash: bool) -> io::Result<Self> {
         let (to_parser, chunks) = sync_channel(CHUNKS_AHEAD);
         let reader = std::thread::Builder::new()
-            .name("read-sha256".into())
+            .name("read-ahead".into())
             .spawn(move || {
                 if hash {
                     let mut hashing = Sha256Reader::new(inner);
