@@ -116,7 +116,8 @@ pub struct MatchSelfCheck {
     pub triples: usize,
     /// Triples tried.
     pub tried: usize,
-    /// Triples that closed but were left out as outliers ([`typical_error`]).
+    /// Triples that closed but were left out as outliers (beyond [`OUTLIER_CHI2`] of
+    /// the typical closure).
     pub left_out: usize,
     /// One match's translation error, RMS per axis (m).
     pub xy_m: f64,
