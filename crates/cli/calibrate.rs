@@ -513,15 +513,17 @@ pub fn run(mut args: Args) -> anyhow::Result<()> {
         {
             row.nominal = n.clone().map(nominal_pose);
         }
-        let rows = report.logs.iter_mut().zip(&paths).zip(&mut checksums);
-        for ((row, path), checksum) in rows.filter(|_| provenance) {
-            let (sha256, bytes) = match checksum.take() {
-                Some(c) => c,
-                None => sha256_of_input(path)
-                    .with_context(|| format!("cannot read {} for its checksum", path.display()))?,
-            };
-            row.sha256 = Some(sha256.clone());
-            *checksum = Some((sha256, bytes));
+        if provenance {
+            for ((row, path), checksum) in report.logs.iter_mut().zip(&paths).zip(&mut checksums) {
+                let (sha256, bytes) = match checksum.take() {
+                    Some(c) => c,
+                    None => sha256_of_input(path).with_context(|| {
+                        format!("cannot read {} for its checksum", path.display())
+                    })?,
+                };
+                row.sha256 = Some(sha256.clone());
+                *checksum = Some((sha256, bytes));
+            }
         }
         // A log given in phases: its file's checksum, as its phases have.
         for (row, group) in report.logs_given.iter_mut().zip(&groups) {

@@ -10,6 +10,7 @@
 //! RMS over √3. Closures far beyond the typical one are left out first, as the solver
 //! leaves out samples ([`OUTLIER_CHI2`]).
 
+use crate::health::scan_jitter::median;
 use crate::matching::{match_pairs, MatchStats, ScanNoise};
 use crate::samples::PairSample;
 use odocal_geom::{wrap_angle, Pose2};
@@ -68,12 +69,7 @@ fn typical_error(errors: &[[f64; 2]]) -> Option<TypicalError> {
         let n_f = n.max(1) as f64;
         (n, [sum(0) / (6.0 * n_f), sum(1) / (3.0 * n_f)])
     };
-    let median = |c: usize| {
-        let mut v: Vec<f64> = errors.iter().map(|e| e[c]).collect();
-        let mid = v.len() / 2;
-        v.select_nth_unstable_by(mid, f64::total_cmp);
-        v.get(mid).copied().unwrap_or(0.0)
-    };
+    let median = |c: usize| median(errors.iter().map(|e| e[c]).collect()).unwrap_or(0.0);
     if errors.len() < MIN_TRIPLES {
         return None;
     }
@@ -86,20 +82,18 @@ fn typical_error(errors: &[[f64; 2]]) -> Option<TypicalError> {
     for _ in 0..MAX_ROUNDS {
         if !variance.iter().all(|v| v.is_finite() && *v > 0.0) {
             // Errors of zero (a noise-free log): nothing stands out.
-            kept.iter_mut().for_each(|k| *k = true);
+            kept.fill(true);
             break;
         }
         let next: Vec<bool> = errors
             .iter()
             .map(|e| e[0] / (3.0 * variance[0]) + e[1] / (3.0 * variance[1]) <= OUTLIER_CHI2)
             .collect();
-        let settled = next == kept;
-        kept = next;
-        let (_, v) = rms(&kept);
-        variance = v;
-        if settled {
+        if next == kept {
             break;
         }
+        kept = next;
+        variance = rms(&kept).1;
     }
     let (closures, variance) = rms(&kept);
     (closures >= MIN_TRIPLES).then(|| TypicalError {
