@@ -887,6 +887,7 @@ pub fn calibrate_log(
                 &samples,
                 &opts.solve_options(),
                 synced.match_self_check.as_ref(),
+                opts.lateral_slip,
             )
         },
     );
