@@ -410,26 +410,23 @@ fn calibrate_joint(
             .flatten()
             .for_each(|v| *v *= factor * factor);
     }
+    // Each log's clock-offset uncertainty, in its own σ, carried into the joint σ
+    // (crate::joint_offsets): with several lasers into the whole joint covariance, every
+    // laser's row and the first laser's view alike; the logs' offsets were estimated
+    // apart.
+    let offsets: Vec<crate::joint_offsets::LogOffset> = outcomes
+        .iter()
+        .zip(&laser_of_log)
+        .filter_map(|(o, &laser)| {
+            Some(crate::joint_offsets::LogOffset {
+                laser,
+                covariance: &o.calibration.covariance,
+                shift: o.offset.as_ref()?.parameter_shift?,
+            })
+        })
+        .collect();
+    crate::joint_offsets::widen_by_offsets(&mut calibration, lasers.as_mut(), &offsets);
     if lasers.is_none() {
-        // Each log's clock-offset uncertainty, in its own σ, carried into the joint σ
-        // (crate::joint_offsets); the logs' offsets were estimated apart.
-        let joint_covariance = calibration.covariance;
-        for o in &outcomes {
-            let moved = o
-                .offset
-                .as_ref()
-                .and_then(|e| e.parameter_shift)
-                .and_then(|d| {
-                    crate::joint_offsets::joint_shift(
-                        &joint_covariance,
-                        &o.calibration.covariance,
-                        &d,
-                    )
-                });
-            if let Some(moved) = moved {
-                odocal_solver::widen_along(&mut calibration, &moved);
-            }
-        }
         // Logs that disagree widen the joint σ to their spread: the logs given when
         // they are phases, else each log.
         let what = if phases_alike.is_empty() {

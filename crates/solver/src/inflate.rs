@@ -4,6 +4,7 @@
 //! uncertainty of a quantity the estimate was computed at (the clock offset).
 
 use crate::calibrate::Calibration;
+use crate::lasers::LasersCalibration;
 
 /// Multiplies every σ of `calibration` by `factor` (the covariance by `factor²`) and
 /// judges the parameters again; a `factor` that is not finite or below 1 changes
@@ -41,16 +42,35 @@ pub fn inflate_sigma_per_parameter(calibration: &mut Calibration, factors: [f64;
 /// offset, say), `shift` being how far the parameters (r_L, r_R, b, ℓx, ℓy, ℓθ) move
 /// when that quantity moves by its σ. Entries that are not finite count as 0.
 pub fn widen_along(calibration: &mut Calibration, shift: &[f64; 6]) {
-    let shift = shift.map(|s| if s.is_finite() { s } else { 0.0 });
-    if shift.iter().all(|&s| s == 0.0) {
-        return;
+    if add_outer(&mut calibration.covariance, shift) {
+        calibration
+            .observability
+            .rejudge(&calibration.params, &calibration.covariance);
     }
-    for (i, row) in calibration.covariance.iter_mut().enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
-            *v += shift[i] * shift[j];
+}
+
+/// [`widen_along`] for the joint estimate of several lasers: adds `shift · shiftᵀ` to
+/// its `(3+3K)×(3+3K)` covariance, `shift` in the order of
+/// [`LasersCalibration::params`] (a shorter `shift` widens its leading parameters
+/// only). Entries that are not finite count as 0. Its views
+/// ([`LasersCalibration::view`], [`LasersCalibration::covariance_of`],
+/// [`LasersCalibration::from_first`]) read the widened covariance; its `first` and
+/// `own` estimates are left as they are.
+pub fn widen_lasers_along(lasers: &mut LasersCalibration, shift: &[f64]) {
+    add_outer(&mut lasers.covariance, shift);
+}
+
+/// Adds `shift · shiftᵀ` to `covariance` (entries of `shift` that are not finite
+/// counting as 0, rows and columns beyond it untouched); whether anything was added.
+fn add_outer<R: AsMut<[f64]>>(covariance: &mut [R], shift: &[f64]) -> bool {
+    let finite = |s: &f64| if s.is_finite() { *s } else { 0.0 };
+    if shift.iter().map(finite).all(|s| s == 0.0) {
+        return false;
+    }
+    for (row, a) in covariance.iter_mut().zip(shift.iter().map(finite)) {
+        for (v, b) in row.as_mut().iter_mut().zip(shift.iter().map(finite)) {
+            *v += a * b;
         }
     }
-    calibration
-        .observability
-        .rejudge(&calibration.params, &calibration.covariance);
+    true
 }

@@ -64,8 +64,11 @@ impl LasersCalibration {
         (self.params.len() - 3) / 3
     }
 
-    /// Indices in [`LasersCalibration::params`] of (r_L, r_R, b, ℓx_k, ℓy_k, ℓθ_k).
-    fn indices(k: usize) -> [usize; 6] {
+    /// Indices in [`LasersCalibration::params`] (and rows and columns of
+    /// [`LasersCalibration::covariance`]) of (r_L, r_R, b, ℓx_k, ℓy_k, ℓθ_k): laser
+    /// `k`'s six parameters, in the order of a single-laser [`Calibration`]. Laser 0's
+    /// are `0..6`, so with one laser they are the whole vector.
+    pub fn indices(k: usize) -> [usize; 6] {
         [0, 1, 2, 3 + 3 * k, 4 + 3 * k, 5 + 3 * k]
     }
 

@@ -84,7 +84,7 @@ pub use constraints::{
 };
 pub use covariance::INFORMATION_SINGULAR_RATIO;
 pub use error::SolveError;
-pub use inflate::{inflate_sigma, inflate_sigma_per_parameter, widen_along};
+pub use inflate::{inflate_sigma, inflate_sigma_per_parameter, widen_along, widen_lasers_along};
 pub use kinematics::{odometry, predict, predict_with_jacobian, residual, residuals, Predictor};
 pub use lasers::{
     calibrate_lasers, calibrate_lasers_constrained, laser_constraints, LasersCalibration,
