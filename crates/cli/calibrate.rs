@@ -1,6 +1,7 @@
 //! `odocal calibrate LOG [LOG …]`: raw logs in, calibrated robot out (several logs of
 //! one robot are calibrated jointly).
 
+use crate::hashing_thread::Checksum;
 use crate::heading_refusal::with_joint_states_command;
 use crate::input::InputArgs;
 use crate::nominal::{describe, odometry_only_mode};
@@ -232,7 +233,7 @@ struct LogInputs<'a> {
     paths: Vec<&'a std::path::Path>,
     names: Vec<String>,
     topics: Vec<Option<String>>,
-    checksums: Vec<Option<(String, u64)>>,
+    checksums: Vec<Option<Checksum>>,
     /// With `--all-pairs`: which of `logs` are the phases of which log given.
     groups: Vec<odocal_pipeline::LogPhases>,
 }
@@ -368,7 +369,7 @@ pub fn run(mut args: Args) -> anyhow::Result<()> {
         Ok(heading) => anyhow::Error::from(heading),
         Err(e) => crate::partial_args::with_hold_command(e),
     };
-    let (mut logs, checksums): (Vec<Log>, Vec<Option<(String, u64)>>) =
+    let (mut logs, checksums): (Vec<Log>, Vec<Option<Checksum>>) =
         inputs.into_iter().map(|(_, r)| (r.log, r.checksum)).unzip();
 
     let initial_params = input.nominal_with_laser(laser.as_ref())?;

@@ -3,7 +3,7 @@
 //! substitution (`<(zcat run.log.gz)`) or standard input (`-`), and its checksum is
 //! computed on the same pass (read and hashed on another thread: [`HashedInput`]).
 
-use crate::hashing_thread::HashedInput;
+use crate::hashing_thread::{Checksum, HashedInput};
 use anyhow::Context;
 use odocal_bag::{bag_format_of_head, detect_bag};
 use odocal_log::{read_log_from, Log, LogError, ReadOptions};
@@ -52,7 +52,7 @@ pub fn read_text_log(
     path: &Path,
     opts: &ReadOptions,
     checksum: bool,
-) -> anyhow::Result<(Log, Option<(String, u64)>)> {
+) -> anyhow::Result<(Log, Option<Checksum>)> {
     let name = input_name(path);
     let source: Box<dyn Read + Send> = if is_stdin(path) {
         Box::new(io::stdin())

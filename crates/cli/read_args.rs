@@ -3,6 +3,7 @@
 //! exists on every such command. The input is a Carmen/JSON log or a ROS bag (ROS 1
 //! `.bag`, ROS 2 directory, `.mcap`, `.db3`), told apart by content.
 
+use crate::hashing_thread::Checksum;
 use crate::open_input::{is_bag_file, read_text_log};
 use crate::terminal::errln;
 use odocal_bag::{read_bag, read_bag_lasers, BagOptions, Clock, NominalLaser, TopicChoice};
@@ -221,7 +222,7 @@ pub struct ReadInput {
     /// SHA-256 (hex) and size of a text log, computed on the one pass that read it
     /// when [`ReadArgs::checksum`] asks for it (`None` for a bag: see
     /// `sha256_of_input`).
-    pub checksum: Option<(String, u64)>,
+    pub checksum: Option<Checksum>,
     /// The laser's pose from a bag's static transforms, when it has them.
     pub nominal_laser: Option<NominalLaser>,
     /// A bag's joint-state and IMU topics (for the odometry-only heading refusal).

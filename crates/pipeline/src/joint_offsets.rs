@@ -56,19 +56,6 @@ pub fn joint_move(
     moved.iter().all(|v| v.is_finite()).then_some(moved)
 }
 
-/// [`joint_move`] of a joint estimate of the six parameters themselves (one laser:
-/// `joint · log⁻¹ · shift`).
-pub fn joint_shift(
-    joint: &[[f64; 6]; 6],
-    log: &[[f64; 6]; 6],
-    shift: &[f64; 6],
-) -> Option<[f64; 6]> {
-    let rows: Vec<Vec<f64>> = joint.iter().map(|r| r.to_vec()).collect();
-    joint_move(&rows, &LasersCalibration::indices(0), log, shift)?
-        .try_into()
-        .ok()
-}
-
 /// One log's part in [`widen_by_offsets`].
 #[derive(Debug, Clone, Copy)]
 pub struct LogOffset<'a> {
@@ -119,6 +106,19 @@ pub fn widen_by_offsets(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`joint_move`] of a joint estimate of the six parameters themselves (one laser:
+    /// `joint · log⁻¹ · shift`).
+    fn joint_shift(
+        joint: &[[f64; 6]; 6],
+        log: &[[f64; 6]; 6],
+        shift: &[f64; 6],
+    ) -> Option<[f64; 6]> {
+        let rows: Vec<Vec<f64>> = joint.iter().map(|r| r.to_vec()).collect();
+        joint_move(&rows, &LasersCalibration::indices(0), log, shift)?
+            .try_into()
+            .ok()
+    }
 
     fn diagonal(d: [f64; 6]) -> [[f64; 6]; 6] {
         std::array::from_fn(|i| std::array::from_fn(|j| if i == j { d[i] } else { 0.0 }))
