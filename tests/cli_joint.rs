@@ -94,7 +94,7 @@ fn logs_of_two_robots_are_refused_with_their_names() {
     assert!(!err.contains("panicked"), "{err}");
     assert!(err.contains("do not describe one robot"), "{err}");
     assert!(
-        err.contains("turtlebot_lds.bag and the joint estimate disagree"),
+        err.contains("turtlebot_lds.bag and the other log disagree"),
         "{err}"
     );
     assert!(err.contains("calibrate them separately"), "{err}");

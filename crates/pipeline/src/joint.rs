@@ -371,24 +371,56 @@ fn calibrate_joint(
                 solved.lasers.is_some() && laser_of_log.iter().filter(|&&j| j == k).count() == 1;
             let constraints = lasers.constraints_of(k, &solve_options.constraints);
             let compared = comparison_options(&solve_options, constraints, &view, alone);
+            // One laser: the other logs' own estimates are the comparison's other side.
+            let others: Vec<&Calibration> = if solved.lasers.is_none() {
+                outcomes
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, _)| j != index)
+                    .map(|(_, other)| &other.calibration)
+                    .collect()
+            } else {
+                Vec::new()
+            };
             match (&joint_of_phases, phases_alike.get(index)) {
                 (Some(joint), Some(alike)) => check_phase(alike, joint, &compared, name),
-                _ => check_log(&o.calibration, &view, &compared, name, alone),
+                _ => check_log(&o.calibration, &others, &view, &compared, name, alone),
             }
+        })
+        .collect();
+    // Each log given in phases, its phases sharing their errors as they do in the
+    // joint solve, against the other logs so given.
+    let group_calibrations: Vec<Calibration> = group_estimates
+        .into_iter()
+        .map(|(mut calibration, shared)| {
+            odocal_solver::inflate_sigma(&mut calibration, shared.map_or(1.0, |c| c.sigma_factor));
+            calibration
         })
         .collect();
     let phase_groups: Vec<PhaseGroupCheck> = groups
         .iter()
-        .zip(group_estimates)
-        .map(|(g, (mut calibration, shared))| {
-            // Its phases share their errors as they do in the joint solve.
-            odocal_solver::inflate_sigma(&mut calibration, shared.map_or(1.0, |c| c.sigma_factor));
+        .zip(&group_calibrations)
+        .enumerate()
+        .map(|(index, (g, calibration))| {
             let name = format!("{} (its {} phases together)", g.name, g.logs.len());
-            let agreement = check_log(&calibration, &solved.first, &solve_options, &name, false);
+            let others: Vec<&Calibration> = group_calibrations
+                .iter()
+                .enumerate()
+                .filter(|&(j, _)| j != index)
+                .map(|(_, c)| c)
+                .collect();
+            let agreement = check_log(
+                calibration,
+                &others,
+                &solved.first,
+                &solve_options,
+                &name,
+                false,
+            );
             PhaseGroupCheck {
                 name: g.name.clone(),
                 logs: g.logs.clone(),
-                calibration,
+                calibration: calibration.clone(),
                 agreement,
             }
         })

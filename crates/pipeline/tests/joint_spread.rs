@@ -139,9 +139,14 @@ fn in_phases(logs: &[(&str, &Log)]) -> (Vec<(String, Log)>, Vec<LogPhases>) {
 
 #[test]
 fn logs_given_in_phases_are_compared_as_wholes() {
+    // Seeds 500 and 501: the pairs 221/222 (this test's seeds until stop 53) differ
+    // in r_L and r_R by 3.2σ by their own estimates (χ² 12.5 for 6), a tail no
+    // comparison rule should call agreement; of 24 pairs of such logs (seeds
+    // 500–547) none differed beyond 3σ (their differences' RMS z 0.64–1.13 per
+    // parameter, mean χ²/dof 0.86).
     for (b_scale, agree) in [(1.0, true), (1.03, false)] {
-        let a = sim("khepera", 221, 60.0, TrajectoryKind::Mixed, 1.0);
-        let b = sim("khepera", 222, 60.0, TrajectoryKind::Mixed, b_scale);
+        let a = sim("khepera", 500, 60.0, TrajectoryKind::Mixed, 1.0);
+        let b = sim("khepera", 501, 60.0, TrajectoryKind::Mixed, b_scale);
         let (phases, groups) = in_phases(&[("a.log", &a), ("b.log", &b)]);
         assert!(groups.iter().all(|g| g.logs.len() > 1), "{groups:?}");
         let named: Vec<(&str, &Log)> = phases.iter().map(|(n, l)| (n.as_str(), l)).collect();
