@@ -74,8 +74,9 @@ fn the_phases_of_one_log_are_judged_by_the_joint_sigma_for_their_share() {
     let spread = own_b.iter().copied().fold(0.0, f64::max)
         / own_b.iter().copied().fold(f64::INFINITY, f64::min);
     // With the samples weighted by the matcher's covariance of each (stop 47) the
-    // phases' noise estimates differ less: 1.2×.
-    assert!(spread > 1.1, "the phases' own σ of b: {own_b:?}");
+    // phases' noise estimates differ less: 1.2×; with each match taken at its shape
+    // in the σ (stop 53), 1.06×. The rule stays: a phase's own σ is one noisy draw.
+    println!("the phases' own σ of b: {own_b:?}, spread {spread:.2}×");
     for row in rows {
         assert_eq!(row["dof"].as_u64(), Some(6), "{row}");
         assert_eq!(row["agree"].as_bool(), Some(true), "{row}");
@@ -105,40 +106,21 @@ fn too_many_phases_and_several_lasers_are_refused_with_the_way_out() {
 }
 
 #[test]
-fn the_real_forward_only_logs_are_offered_every_pair_and_gain_from_it() {
+fn the_real_forward_only_logs_calibrate_and_every_pair_narrows_their_sigma() {
     for name in ["exp1.log", "exp2.log"] {
         let Some(path) = mines_log(name) else {
             continue;
         };
         let log = path.to_str().unwrap();
+        // Measured (stop 47): with the samples weighted by the matcher's covariance
+        // of each, exp1 determines all six (ℓx 162.7 ± 10.1 mm, within 0.3σ of exp2's
+        // 158.1 ± 16.7 mm) and calibrates as it is; since stop 53 (each match taken at
+        // its shape in the σ) exp2 does too (b 304.0 ± 3.8 mm, ℓx 160.5 ± 14.4 mm;
+        // it was refused, b and ℓx weak). A simulated forward-only log that is
+        // refused is offered every pair in
+        // `a_refusal_of_every_pair_gives_the_command_that_holds_what_is_weak`.
         let o = odocal(&["calibrate", log]);
-        let err = stderr(&o);
-        if name == "exp1.log" {
-            // Measured (stop 47): with the samples weighted by the matcher's
-            // covariance of each, exp1 determines all six (ℓx 162.7 ± 10.1 mm, within
-            // 0.3σ of exp2's 158.1 ± 16.7 mm) and calibrates as it is.
-            assert!(o.status.success(), "{err}");
-        } else {
-            // Refused (b and ℓx weak: no spins in place), with --all-pairs among the
-            // ways out.
-            assert!(!o.status.success(), "{err}");
-            let offered = command_after(&err, "or first, to use every scan pair");
-            assert!(offered.ends_with("--all-pairs"), "{offered}");
-            // Under --json too, beside the command that holds parameters.
-            let o = odocal(&["calibrate", log, "--json"]);
-            assert!(!o.status.success());
-            let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
-            let command = v["all_pairs_command"]
-                .as_str()
-                .unwrap_or_else(|| panic!("{v}"));
-            assert!(command.ends_with("--json --all-pairs"), "{command}");
-            assert!(
-                v["suggested_command"]
-                    .as_str()
-                    .is_some_and(|c| c.contains("--fix")),
-                "{v}"
-            );
-        }
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
         // Measured (stop 44): the real logs' phases share their errors where their
         // pairs overlap (residuals correlated by 0.46–0.83 at full overlap: the
         // wheels' slips and scrubs), so every pair narrows the pose σ by less than the
@@ -147,13 +129,16 @@ fn the_real_forward_only_logs_are_offered_every_pair_and_gain_from_it() {
         let one = calibrate_json(&[log, "--accept-weak"]);
         let all = calibrate_json(&[log, "--accept-weak", "--all-pairs"]);
         let (s1, sa) = (pose_sigma(&one), pose_sigma(&all));
-        // Measured (stop 47, the samples weighted by the matcher's covariance of each):
-        // exp2's ℓθ narrows 2.1× (11.4 → 5.4 mrad), a little more than four
-        // independent phases would (the default pairing's 104 samples against every
-        // pair's 441).
+        // Measured (stop 53, each match taken at its shape in the σ): exp2's pose σ
+        // narrow 1.3–2.2× (ℓθ 10.0 → 4.6 mrad), about what four independent phases
+        // would give (the default pairing's 104 samples against every pair's 439);
+        // exp1's ℓy and ℓθ narrow a little (6.7 → 6.1 mm, 6.0 → 5.7 mrad) and its ℓx
+        // widens by 6 % (9.6 → 10.2 mm): its phases share more of their errors
+        // (σ ×1.76), and its own noise estimate differs by the pairing.
         for i in 0..3 {
+            let widest = if name == "exp2.log" { 1.0 } else { 1.1 };
             assert!(
-                sa[i] < s1[i] && sa[i] > s1[i] / 2.5,
+                sa[i] < widest * s1[i] && sa[i] > s1[i] / 2.5,
                 "{name} pose σ {i}: {} → {}",
                 s1[i],
                 sa[i]
@@ -184,9 +169,10 @@ fn the_real_logs_given_in_phases_are_compared_and_their_spread_kept() {
         return;
     };
     let (exp1, exp2) = (exp1.to_str().unwrap(), exp2.to_str().unwrap());
-    // Default pairing: exp2 leaves b and ℓx weak and is compared on the other four;
-    // exp1 determines all six (stop 47: the samples weighted by the matcher's
-    // covariance of each).
+    // Default pairing: each log determines all six (exp1 since stop 47, the samples
+    // weighted by the matcher's covariance of each; exp2 since stop 53, each match
+    // taken at its shape in the σ: it left b and ℓx weak and was compared on the
+    // other four).
     let v = calibrate_json(&[exp1, exp2, "--accept-weak"]);
     let dof: Vec<Option<u64>> = v["logs"]
         .as_array()
@@ -194,7 +180,7 @@ fn the_real_logs_given_in_phases_are_compared_and_their_spread_kept() {
         .iter()
         .map(|row| row["dof"].as_u64())
         .collect();
-    assert_eq!(dof, [Some(6), Some(4)], "{}", v["logs"]);
+    assert_eq!(dof, [Some(6), Some(6)], "{}", v["logs"]);
     // Each log's two halves leave more weak (measured, stop 47: ℓx in exp1's; r_L, b,
     // ℓx, ℓy in exp2's), and are compared on the others instead of not at all.
     for log in [exp1, exp2] {
@@ -247,14 +233,35 @@ fn the_real_logs_given_in_phases_are_compared_and_their_spread_kept() {
 
 #[test]
 fn a_refusal_of_every_pair_gives_the_command_that_holds_what_is_weak() {
-    // A rover driven without spins in place (as the real MinesRover logs), 15 s of
+    // A rover driven without spins in place (as the real MinesRover logs), 10 s of
     // straights: ℓx weak even with every pair. (Since stop 51, with the self-check's
     // outlying closures left out, 40 s of the same drive determine all six with every
-    // pair: seeds 301–322, those of 301–308 every parameter within 2.4σ of the truth.)
-    let (path, truth) = simulated_log("all-pairs-hold", "mines-rover", 15.0, 304, |c| {
+    // pair: seeds 301–322, those of 301–308 every parameter within 2.4σ of the truth;
+    // since stop 53, each match taken at its shape in the σ, 15 s do.)
+    let (path, truth) = simulated_log("all-pairs-hold", "mines-rover", 10.0, 304, |c| {
         c.trajectory = odocal_sim::TrajectoryKind::NoSpins;
     });
     let log = path.to_str().unwrap();
+    // Refused by default (ℓx and ℓy weak), with --all-pairs among the ways out, under
+    // --json too beside the command that holds parameters.
+    let o = odocal(&["calibrate", log]);
+    let err = stderr(&o);
+    assert!(!o.status.success(), "{err}");
+    let offered = command_after(&err, "or first, to use every scan pair");
+    assert!(offered.ends_with("--all-pairs"), "{offered}");
+    let o = odocal(&["calibrate", log, "--json"]);
+    assert!(!o.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("one JSON object");
+    let command = v["all_pairs_command"]
+        .as_str()
+        .unwrap_or_else(|| panic!("{v}"));
+    assert!(command.ends_with("--json --all-pairs"), "{command}");
+    assert!(
+        v["suggested_command"]
+            .as_str()
+            .is_some_and(|c| c.contains("--fix")),
+        "{v}"
+    );
     let o = odocal(&["calibrate", log, "--all-pairs"]);
     let err = stderr(&o);
     assert!(!o.status.success(), "{err}");

@@ -8,7 +8,7 @@ mod common;
 
 use common::accuracy::calibrate;
 use common::{cleanup, mines_log, simulated_log};
-use odocal_pipeline::{FindingKind, Options, SlideModel};
+use odocal_pipeline::{Finding, FindingKind, Options, Severity, SlideModel};
 use odocal_report::Report;
 
 /// The true slide of the tests (s): a 3° slip angle at 1 rad/s.
@@ -169,7 +169,21 @@ fn clean_logs_do_not_raise_the_slide() {
         let report = calibrate(&path, &with_model(SlideModel::Auto));
         let slip = report.lateral_slip.expect("the slide is checked");
         println!("{preset} seed {seed}: {slip:?}");
-        assert!(!slide_found(&report), "{preset}: {slip:?}");
+        // No slide found. A note may say that not knowing k makes up most of a σ (and
+        // that `--no-lateral-slip` leaves it out on a differential drive): since the
+        // σ take each match at its shape (stop 53), the Khepera's ℓθ σ is narrow
+        // enough for the slide the data do not rule out to make up 65 % of it.
+        let said: Vec<&Finding> = report
+            .health
+            .iter()
+            .filter(|f| f.kind == FindingKind::LateralSlip)
+            .collect();
+        assert!(
+            said.iter().all(|f| f.severity == Severity::Info
+                && f.message.contains("not knowing k makes up")
+                && f.message.contains("--no-lateral-slip")),
+            "{preset}: {said:?}"
+        );
         // The slide weighs little (an outward k well below 2σ), or nothing (inward):
         // the estimate is Off's, the six-parameter one, within a tenth of its σ.
         assert!(slip.weight < 0.2, "{preset}: {slip:?}");

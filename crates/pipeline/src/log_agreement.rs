@@ -34,7 +34,7 @@ use odocal_solver::{Calibration, Params, SolveOptions, Verdict, PARAMETER_NAMES}
 /// covariance would describe a linearization that is not valid.
 ///
 /// `others` are the other logs' own estimates (their σ as the logs report them): the
-/// log is compared with their combination ([`combined`]) when they give one on the
+/// log is compared with their combination (by their information) when they give one on the
 /// parameters compared, else with the joint estimate by `C_log − C_joint`.
 pub fn check_log(
     log: &Calibration,

@@ -551,14 +551,13 @@ impl fmt::Display for Report {
                 f,
                 "  each sample weighted by the typical match's σ (x {:.3} mm, y {:.3} mm, θ \
                  {:.4}°) shaped as the matcher's covariance of it compares with the typical \
-                 match's; the residuals follow it by {:.0} %, {:.0} %, {:.0} % (x, y, θ), and \
-                 the σ take the noise as that blend",
+                 match's; the residuals follow the spread in the matches' sizes by {:.0} %, \
+                 and the σ take each match's noise at that blend of its size with the \
+                 typical one, its shape kept",
                 n.weight_level[0] * 1e3,
                 n.weight_level[1] * 1e3,
                 n.weight_level[2].to_degrees(),
-                100.0 * n.share[0],
-                100.0 * n.share[1],
-                100.0 * n.share[2]
+                100.0 * n.share
             )?;
         }
         if let Some(n) = &self.shared_scan_noise {

@@ -518,7 +518,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     };
     let weight_level = shapes
         .as_ref()
-        .map(|m| m.level(&active, &residuals_at(&active, &cf.params), [1.0; 3]));
+        .map(|m| m.level(&active, &residuals_at(&active, &cf.params), 1.0));
     let shaped = shapes
         .as_ref()
         .zip(weight_level)
@@ -553,7 +553,7 @@ pub fn calibrate(samples: &[Sample], options: &SolveOptions) -> Result<Calibrati
     // the residuals support (`crate::noise_shape`).
     let noise_shaping = shapes.as_ref().zip(weight_level).map(|(m, weight_level)| {
         let residuals = residuals_at(&active, &params);
-        let share = m.share_followed(&active, &residuals);
+        let share = m.share_followed(&active, &residuals, weight_level);
         NoiseShaping {
             weight_level,
             share,

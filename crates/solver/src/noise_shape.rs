@@ -16,19 +16,28 @@
 //! mrad), and a short log's few spins, which the matcher finds 3–5× noisier than
 //! its straights, no longer decide the laser's offsets alone.
 //!
-//! The matcher's covariance predicts the residuals only in part: the wheels' own
-//! noise is the same for every sample, and a match can be off more or less than it
-//! says. How far it predicts them is measured on the log, per component: the share
-//! `w` for which the squared residuals over `(1 − w) + w·g` (`g` the relative
-//! variance) have the same median among the samples the matcher finds noisiest as
-//! among the quietest ([`NoiseShapes::share_followed`]; 10–90 % on the simulated
-//! presets and the real MinesRover logs). The covariance of the estimate takes the
-//! noise as that blend, `R̃_k = (I − W) + W^½ R_k W^½`: the shared-scan model
+//! The matcher's covariance predicts the residuals only in part, and not evenly: its
+//! shape (which direction of a match is the well-determined one) holds, its size
+//! (how much noisier one match is than another) is overstated. Measured against the
+//! simulator's truth on 60 MinesRover logs, along each match's best-determined axis
+//! the squared error over the shape's variance was 1.23, 1.00, 0.87, 0.62 from the
+//! smallest quarter of the matches to the largest, while the error's whole
+//! Mahalanobis size over three went 1.34 → 0.65 (docs/benchmarks.md, stop 52). How
+//! far the sizes hold is measured on the log: the share `w` of the spread in sizes
+//! `s_k = det(R_k)^⅓` for which the residuals, whitened by their shapes at the
+//! typical size, squared and divided by `(1 − w) + w·s_k`, have the same median among
+//! the largest matches as among the smallest ([`NoiseShapes::share_followed`]). The
+//! covariance of the estimate takes each sample's noise as its shape at that blend of
+//! sizes, `R̃_k = R_k·((1 − w) + w·s_k)/s_k`: the shared-scan model
 //! (`crate::shared_scans`) is estimated on the residuals whitened by its map
-//! `M̃_k⁻¹`, where one level holds, and its score mapped back by `M̃_k`. Weighting
-//! by the matcher's full shapes is what makes the estimate precise; taking them at
-//! their word in its covariance would make it overconfident (the TurtleBot 4's ℓθ
-//! at 1.35 RMS error/σ).
+//! `M̃_k⁻¹`, where one level holds, and its score mapped back by `M̃_k`. Weighting by
+//! the matcher's full covariances is what makes the estimate precise; taking their
+//! sizes at their word in its covariance would make it overconfident (the
+//! TurtleBot 4's ℓθ at 1.35 RMS error/σ). An earlier blend per component,
+//! `(I − W) + W^½ R_k W^½`, lost the shapes too: along each match's best-determined
+//! axis, where the weights trust it most, it took the noise 2–2.7× too large, and
+//! the realistic presets' σ were wide (the rover's ℓθ and ℓy at 0.53 and 0.63 RMS
+//! error/σ).
 
 use crate::calibrate::{Calibration, NoiseSource};
 use crate::kinematics::Predictor;
@@ -93,21 +102,19 @@ impl NoiseShapes {
     }
 
     /// Per sample, the map `M_k = diag(σ) L_k diag(1/σ)` from a noise of the typical
-    /// match's `level` (σ) to the sample's own, `L_k L_kᵀ` its shape blended with the level
-    /// by `share` per component: `(I − W) + W^½ R_k W^½`, `W = diag(share)` (1: the
-    /// matcher's shapes as they are). The identity for a sample without a shape or
-    /// whose blend is not positive definite.
-    pub(crate) fn maps(&self, level: [f64; 3], share: [f64; 3]) -> Vec<Matrix3<f64>> {
+    /// match's `level` (σ) to the sample's own, `L_k L_kᵀ = R_k·((1 − w) + w·s_k)/s_k`:
+    /// the matcher's shape `R_k` kept, its size `s_k = det(R_k)^⅓` blended with the
+    /// typical match's by `share` (`w`; 1: the matcher's covariance as it is, 0: its
+    /// shape at the typical size). The identity for a sample without a shape or whose
+    /// shape is not positive definite.
+    pub(crate) fn maps(&self, level: [f64; 3], share: f64) -> Vec<Matrix3<f64>> {
         let sigma = Vector3::from(level);
         let to_level = Matrix3::from_diagonal(&sigma);
         let from_level = Matrix3::from_diagonal(&sigma.map(|s| 1.0 / s));
-        let share = Vector3::from(share.map(|w| w.clamp(0.0, 1.0)));
-        let root = Matrix3::from_diagonal(&share.map(f64::sqrt));
-        let rest = Matrix3::from_diagonal(&share.map(|w| 1.0 - w));
         self.relative
             .iter()
             .map(|r| {
-                r.and_then(|r| (rest + root * r * root).cholesky())
+                r.and_then(|r| (r * size_blend(&r, share)?).cholesky())
                     .map_or_else(Matrix3::identity, |l| to_level * l.l() * from_level)
             })
             .collect()
@@ -127,7 +134,7 @@ impl NoiseShapes {
             return None;
         }
         let typical = Matrix3::from_diagonal(&Vector3::from(level.map(|s| s * s)));
-        self.maps(level, [1.0; 3])
+        self.maps(level, 1.0)
             .iter()
             .map(|m| {
                 let info = (m * typical * m.transpose()).try_inverse()?;
@@ -139,77 +146,82 @@ impl NoiseShapes {
             .collect()
     }
 
-    /// Per component, the share `w` of the residuals' noise that follows the matcher's
-    /// relative variances `g`: the `w` in `[0, 1]` for which the squared residuals
-    /// (`residuals`, one per sample of `active`) divided by `(1 − w) + w·g` have the
-    /// same median among the samples the matcher finds noisiest (its top quarter) as
-    /// among the quietest (its bottom quarter). Medians, because a few confident wrong
-    /// matches would decide a mean. 0 where the shapes do not vary; samples that leave
-    /// a direction free are left out (their residual along it is no noise).
-    pub(crate) fn share_followed(&self, active: &[Packed], residuals: &[[f64; 3]]) -> [f64; 3] {
-        std::array::from_fn(|c| {
-            let mut points: Vec<(f64, f64)> = active
-                .iter()
-                .zip(residuals)
-                .filter(|(p, _)| p.free_direction.is_none())
-                .filter_map(|(p, e)| {
-                    let r = self.relative.get(p.index)?.as_ref()?;
-                    Some((r[(c, c)], e[c] * e[c]))
-                })
-                .collect();
-            if points.len() < MIN_SHAPED_SAMPLES {
-                return 0.0;
-            }
-            points.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-            let quarter = points.len() / 4;
-            let (low, high) = (&points[..quarter], &points[points.len() - quarter..]);
-            // The shapes vary between the quarters (else nothing to follow).
-            if high[high.len() / 2].0.partial_cmp(&low[low.len() / 2].0)
-                != Some(std::cmp::Ordering::Greater)
-            {
-                return 0.0;
-            }
-            // ln(median of the noisy quarter / median of the quiet one), falling in w.
-            let gap = |w: f64| {
-                let scaled = |part: &[(f64, f64)]| {
-                    let mut v: Vec<f64> =
-                        part.iter().map(|&(g, e2)| e2 / (1.0 - w + w * g)).collect();
-                    let mid = v.len() / 2;
-                    *v.select_nth_unstable_by(mid, f64::total_cmp).1
-                };
-                (scaled(high) / scaled(low)).ln()
+    /// The share `w` of the spread in the matches' sizes that the residuals follow:
+    /// the `w` in `[0, 1]` for which the residuals (`residuals`, one per sample of
+    /// `active`), each whitened by its shape at the typical size (`level`, the typical
+    /// match's σ), squared and divided by `(1 − w) + w·s_k`, have the same median among
+    /// the samples the matcher finds largest (its top quarter by `s_k`) as among the
+    /// smallest (its bottom quarter). Medians, because a few confident wrong matches
+    /// would decide a mean. 0 where the sizes do not vary; samples that leave a
+    /// direction free are left out (their residual along it is no noise).
+    pub(crate) fn share_followed(
+        &self,
+        active: &[Packed],
+        residuals: &[[f64; 3]],
+        level: [f64; 3],
+    ) -> f64 {
+        if level.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+            return 0.0;
+        }
+        let from_level = Matrix3::from_diagonal(&Vector3::from(level.map(|s| 1.0 / s)));
+        let mut points: Vec<(f64, f64)> = active
+            .iter()
+            .zip(residuals)
+            .filter(|(p, _)| p.free_direction.is_none())
+            .filter_map(|(p, e)| {
+                let r = self.relative.get(p.index)?.as_ref()?;
+                let size = size_of(r)?;
+                let e = from_level * Vector3::from(*e);
+                let whitened = (r / size).cholesky()?.solve(&e);
+                Some((size, e.dot(&whitened) / 3.0))
+            })
+            .collect();
+        if points.len() < MIN_SHAPED_SAMPLES {
+            return 0.0;
+        }
+        points.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let quarter = points.len() / 4;
+        let (low, high) = (&points[..quarter], &points[points.len() - quarter..]);
+        // The sizes vary between the quarters (else nothing to follow).
+        if high[high.len() / 2].0.partial_cmp(&low[low.len() / 2].0)
+            != Some(std::cmp::Ordering::Greater)
+        {
+            return 0.0;
+        }
+        // ln(median of the large quarter / median of the small one), falling in w.
+        let gap = |w: f64| {
+            let scaled = |part: &[(f64, f64)]| {
+                let mut v: Vec<f64> = part.iter().map(|&(s, q)| q / (1.0 - w + w * s)).collect();
+                let mid = v.len() / 2;
+                *v.select_nth_unstable_by(mid, f64::total_cmp).1
             };
-            if gap(0.0).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                return 0.0;
+            (scaled(high) / scaled(low)).ln()
+        };
+        if gap(0.0).partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+            return 0.0;
+        }
+        if gap(1.0) >= 0.0 {
+            return 1.0;
+        }
+        let (mut lo, mut hi) = (0.0, 1.0);
+        for _ in 0..30 {
+            let mid = 0.5 * (lo + hi);
+            if gap(mid) > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
             }
-            if gap(1.0) >= 0.0 {
-                return 1.0;
-            }
-            let (mut lo, mut hi) = (0.0, 1.0);
-            for _ in 0..30 {
-                let mid = 0.5 * (lo + hi);
-                if gap(mid) > 0.0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            0.5 * (lo + hi)
-        })
+        }
+        0.5 * (lo + hi)
     }
 
     /// Per component, the noise's level under the blend `share`: the root mean square
     /// of the residuals (`residuals`, one per sample of `active`) each divided by its
-    /// relative standard deviation under the blend, over `n − 2` (six parameters
-    /// fitted on three components). Samples that leave a direction free are left out.
-    pub(crate) fn level(
-        &self,
-        active: &[Packed],
-        residuals: &[[f64; 3]],
-        share: [f64; 3],
-    ) -> [f64; 3] {
+    /// relative standard deviation under the blend ([`NoiseShapes::maps`]), over
+    /// `n − 2` (six parameters fitted on three components). Samples that leave a
+    /// direction free are left out.
+    pub(crate) fn level(&self, active: &[Packed], residuals: &[[f64; 3]], share: f64) -> [f64; 3] {
         std::array::from_fn(|c| {
-            let w = share[c].clamp(0.0, 1.0);
             let scaled: Vec<f64> = active
                 .iter()
                 .zip(residuals)
@@ -219,14 +231,30 @@ impl NoiseShapes {
                         .relative
                         .get(p.index)
                         .and_then(|r| r.as_ref())
-                        .map_or(1.0, |r| r[(c, c)]);
-                    e[c] * e[c] / (1.0 - w + w * g)
+                        .and_then(|r| Some(r[(c, c)] * size_blend(r, share)?))
+                        .unwrap_or(1.0);
+                    e[c] * e[c] / g
                 })
                 .collect();
             let dof = scaled.len().saturating_sub(2).max(1) as f64;
             (scaled.iter().sum::<f64>() / dof).sqrt()
         })
     }
+}
+
+/// The size of a relative covariance: `det(R)^⅓` (1 for the typical match's);
+/// `None` when it is not positive and finite.
+fn size_of(r: &Matrix3<f64>) -> Option<f64> {
+    let det = r.determinant();
+    (det.is_finite() && det > 0.0).then(|| det.cbrt())
+}
+
+/// The factor `((1 − w) + w·s)/s` that takes `r`, of size `s`, to its size blended
+/// with the typical match's by the share `w` (clamped to `[0, 1]`).
+fn size_blend(r: &Matrix3<f64>, share: f64) -> Option<f64> {
+    let w = share.clamp(0.0, 1.0);
+    let s = size_of(r)?;
+    Some((1.0 - w + w * s) / s)
 }
 
 /// How a solve shaped its samples' noise (see the module documentation).
@@ -236,10 +264,11 @@ pub struct NoiseShaping {
     /// each shaped by the matcher's covariance of it: the residuals at the closed
     /// form divided by their shapes.
     pub weight_level: [f64; 3],
-    /// Per component, the share of the residuals' noise that follows the matcher's
-    /// relative variances, measured on the residuals at the estimate (0: one level
-    /// for all, as if the matcher's covariances said nothing; 1: as the matcher says).
-    pub share: [f64; 3],
+    /// The share of the spread in the matches' sizes (`det^⅓` of the matcher's
+    /// covariance) that the residuals follow, measured on the residuals at the
+    /// estimate (0: every match at the typical size, its shape kept; 1: the matcher's
+    /// covariance as it is).
+    pub share: f64,
     /// The noise's level under that blend (x, y, θ): what the covariance of the
     /// estimate takes each sample's noise as, with the blended shape.
     pub level: [f64; 3],
@@ -323,15 +352,23 @@ mod tests {
         let active = Packed::all(&samples, false);
         let sigma = [2e-3, 1e-3, 5e-4];
         let shapes = NoiseShapes::of(&samples, &active).expect("shapes");
-        let maps = shapes.maps(sigma, [1.0; 3]);
+        let maps = shapes.maps(sigma, 1.0);
         assert!((maps[0] - Matrix3::identity()).norm() < 1e-12);
         // Four times the typical σ in x, the level in y and θ.
         assert!((maps[20][(0, 0)] - 4.0).abs() < 1e-12);
         assert!((maps[20][(1, 1)] - 1.0).abs() < 1e-12);
         assert_eq!(maps[21], Matrix3::identity());
-        // Half the noise following the shapes: variance 0.5 + 0.5·16 in x.
-        let half = shapes.maps(sigma, [0.5; 3]);
-        assert!((half[20][(0, 0)] - 8.5f64.sqrt()).abs() < 1e-12);
+        // Half the sizes' spread followed: the shape diag(16, 1, 1) kept, its size
+        // s = 16^⅓ taken as 0.5 + 0.5·s.
+        let half = shapes.maps(sigma, 0.5);
+        let s = 16f64.cbrt();
+        let f = (0.5 + 0.5 * s) / s;
+        assert!((half[20][(0, 0)] - (16.0 * f).sqrt()).abs() < 1e-12);
+        assert!((half[20][(1, 1)] - f.sqrt()).abs() < 1e-12);
+        // None of it: the typical size, the shape kept.
+        let none = shapes.maps(sigma, 0.0);
+        assert!((none[20].determinant() - 1.0).abs() < 1e-12);
+        assert!((none[20][(0, 0)] / none[20][(1, 1)] - 4.0).abs() < 1e-12);
         let info = shapes.information(sigma).expect("information");
         assert!((info[0][0][0] - 1.0 / 4e-6).abs() < 1e-3);
         assert!((info[20][0][0] - 1.0 / 64e-6).abs() < 1e-3);
@@ -339,8 +376,9 @@ mod tests {
 
     #[test]
     fn the_share_followed_is_measured_on_the_residuals() {
-        // Relative variances 1 (the typical match) and 9 in x; residuals whose squares
-        // follow them fully, half, or not at all.
+        // Relative variances 1 (the typical match) and 9 in x (size 9^⅓); residuals
+        // whose squares follow their sizes fully, half, or not at all, their shapes
+        // kept.
         let mut samples = Vec::new();
         for k in 0..40 {
             let g = if k % 3 == 0 { 9.0 } else { 1.0 };
@@ -348,18 +386,17 @@ mod tests {
         }
         let active = Packed::all(&samples, false);
         let shapes = NoiseShapes::of(&samples, &active).expect("shapes");
+        let level = [1e-3, 1e-3, 3.16e-4];
         for share in [1.0, 0.5, 0.0] {
-            let variance = |g: f64| 1.0 - share + share * g;
             let residuals: Vec<[f64; 3]> = (0..40)
                 .map(|k| {
-                    let g = if k % 3 == 0 { 9.0 } else { 1.0 };
-                    [1e-3 * variance(g).sqrt(), 0.0, 0.0]
+                    let g: f64 = if k % 3 == 0 { 9.0 } else { 1.0 };
+                    let s = g.cbrt();
+                    [1e-3 * (g * (1.0 - share + share * s) / s).sqrt(), 0.0, 0.0]
                 })
                 .collect();
-            let got = shapes.share_followed(&active, &residuals);
-            assert!((got[0] - share).abs() < 1e-6, "{got:?}");
-            // y does not vary in shape: nothing to follow.
-            assert_eq!(got[1], 0.0);
+            let got = shapes.share_followed(&active, &residuals, level);
+            assert!((got - share).abs() < 1e-6, "{got} against {share}");
             // The level: the typical match's σ, whatever the blend.
             let level = shapes.level(&active, &residuals, got);
             assert!(
@@ -367,6 +404,11 @@ mod tests {
                 "{level:?}"
             );
         }
+        // Sizes that do not vary: nothing to follow.
+        let alike: Vec<Sample> = (0..40).map(|_| sample(Some([1e-6, 1e-6, 1e-7]))).collect();
+        let shapes = NoiseShapes::of(&alike, &active).expect("shapes");
+        let residuals = vec![[1e-3, 0.0, 0.0]; 40];
+        assert_eq!(shapes.share_followed(&active, &residuals, level), 0.0);
     }
 
     #[test]
