@@ -93,9 +93,12 @@ fn logs_of_two_robots_are_refused_with_their_names() {
     assert!(!o.status.success(), "{err}");
     assert!(!err.contains("panicked"), "{err}");
     assert!(err.contains("do not describe one robot"), "{err}");
+    // Two logs are one comparison, each against the other: said once, naming both.
     assert!(
-        err.contains("turtlebot_lds.bag and the other log disagree"),
+        err.contains("fixtures/demo.log and fixtures/bags/turtlebot_lds.bag disagree"),
         "{err}"
     );
+    assert_eq!(err.matches("disagree beyond 3σ").count(), 1, "{err}");
+    assert!(err.contains("likely one of the two logs"), "{err}");
     assert!(err.contains("calibrate them separately"), "{err}");
 }

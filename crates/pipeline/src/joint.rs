@@ -372,12 +372,12 @@ fn calibrate_joint(
             let constraints = lasers.constraints_of(k, &solve_options.constraints);
             let compared = comparison_options(&solve_options, constraints, &view, alone);
             // One laser: the other logs' own estimates are the comparison's other side.
-            let others: Vec<&Calibration> = if solved.lasers.is_none() {
-                outcomes
-                    .iter()
+            let others: Vec<(&str, &Calibration)> = if solved.lasers.is_none() {
+                logs.iter()
+                    .zip(&outcomes)
                     .enumerate()
                     .filter(|&(j, _)| j != index)
-                    .map(|(_, other)| &other.calibration)
+                    .map(|(_, ((other, _), o))| (*other, &o.calibration))
                     .collect()
             } else {
                 Vec::new()
@@ -397,24 +397,28 @@ fn calibrate_joint(
             calibration
         })
         .collect();
+    let group_names: Vec<String> = groups
+        .iter()
+        .map(|g| format!("{} (its {} phases together)", g.name, g.logs.len()))
+        .collect();
     let phase_groups: Vec<PhaseGroupCheck> = groups
         .iter()
         .zip(&group_calibrations)
         .enumerate()
         .map(|(index, (g, calibration))| {
-            let name = format!("{} (its {} phases together)", g.name, g.logs.len());
-            let others: Vec<&Calibration> = group_calibrations
+            let others: Vec<(&str, &Calibration)> = group_names
                 .iter()
+                .zip(&group_calibrations)
                 .enumerate()
                 .filter(|&(j, _)| j != index)
-                .map(|(_, c)| c)
+                .map(|(_, (other, c))| (other.as_str(), c))
                 .collect();
             let agreement = check_log(
                 calibration,
                 &others,
                 &solved.first,
                 &solve_options,
-                &name,
+                &group_names[index],
                 false,
             );
             PhaseGroupCheck {
@@ -513,6 +517,16 @@ fn calibrate_joint(
                 } else {
                     let names: Vec<&str> = logs.iter().map(|(n, _)| *n).collect();
                     let which: Vec<usize> = disagreeing.iter().map(|(i, _)| *i).collect();
+                    // Two logs (or two logs given in phases) are one comparison, each
+                    // against the other: said once.
+                    let given = if groups.is_empty() {
+                        logs.len()
+                    } else {
+                        groups.len()
+                    };
+                    if given == 2 {
+                        disagreeing.truncate(1);
+                    }
                     let mut sentences: Vec<String> =
                         disagreeing.into_iter().map(|(_, s)| s).collect();
                     // Phases are not logs to give a laser of their own (`--own-laser`

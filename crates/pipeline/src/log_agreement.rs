@@ -19,11 +19,12 @@ use crate::consistency::{
 use nalgebra::{DMatrix, DVector};
 use odocal_solver::{Calibration, Params, SolveOptions, Verdict, PARAMETER_NAMES};
 
-/// Compares one log's own estimate `log` with the joint estimate `joint`; `name`
-/// names the log in the sentence. With `own_covariance` the difference is judged by
-/// the log's own covariance (conservative: for a log that is the only one of its
-/// laser in a joint solve of several lasers, whose `C_log − C_joint` is nearly
-/// singular and no longer the difference's covariance).
+/// Compares one log's own estimate `log` with the other logs' (`others`), or with the
+/// joint estimate `joint`; `name` names the log in the sentence. With
+/// `own_covariance` the difference with the joint estimate is judged by the log's own
+/// covariance (conservative: for a log that is the only one of its laser in a joint
+/// solve of several lasers, whose `C_log − C_joint` is nearly singular and no longer
+/// the difference's covariance).
 ///
 /// A log that alone leaves a free parameter weak is compared on the parameters it
 /// determines well (their marginal covariance), the weak ones named and left out:
@@ -33,12 +34,13 @@ use odocal_solver::{Calibration, Params, SolveOptions, Verdict, PARAMETER_NAMES}
 /// lands on the mirror solution is not compared (the reason is given): its
 /// covariance would describe a linearization that is not valid.
 ///
-/// `others` are the other logs' own estimates (their σ as the logs report them): the
-/// log is compared with their combination (by their information) when they give one on the
-/// parameters compared, else with the joint estimate by `C_log − C_joint`.
+/// `others` are the other logs' names and own estimates (their σ as the logs report
+/// them): the log is compared with their combination by their information when they
+/// give one on the parameters compared, else with the joint estimate by
+/// `C_log − C_joint` (several lasers, or `own_covariance`).
 pub fn check_log(
     log: &Calibration,
-    others: &[&Calibration],
+    others: &[(&str, &Calibration)],
     joint: &Calibration,
     options: &SolveOptions,
     name: &str,
@@ -51,7 +53,7 @@ pub fn check_log(
 /// that fit a whole log).
 fn check_with_cause(
     log: &Calibration,
-    others: &[&Calibration],
+    others: &[(&str, &Calibration)],
     joint: &Calibration,
     options: &SolveOptions,
     name: &str,
@@ -83,18 +85,19 @@ fn check_with_cause(
     }
     // The weak parameters are left out: the comparison is over the others' marginal.
     let compared = leaving_out(options, &weak, joint);
-    let usable: Vec<&Calibration> = others
+    let usable: Vec<(&str, &Calibration)> = others
         .iter()
         .copied()
-        .filter(|c| sign(c) == sign(joint))
+        .filter(|(_, c)| sign(c) == sign(joint))
         .collect();
+    let estimates: Vec<&Calibration> = usable.iter().map(|(_, c)| *c).collect();
     let rest = (!own_covariance)
-        .then(|| combined(log, &usable, joint, &compared))
+        .then(|| combined(log, &estimates, joint, &compared))
         .flatten();
-    let other_side = match (&rest, usable.len()) {
-        (Some(_), 1) => "the other log",
-        (Some(_), _) => "the other logs together",
-        (None, _) => "the joint estimate",
+    let other_side = match (&rest, usable.as_slice()) {
+        (Some(_), [(other, _)]) => other.to_string(),
+        (Some(_), _) => "the other logs together".to_string(),
+        (None, _) => "the joint estimate".to_string(),
     };
     let what = if weak.is_empty() {
         format!("{name} and {other_side}")
@@ -117,7 +120,11 @@ fn check_with_cause(
         }
     };
     if !check.agree {
-        check.sentence = disagreement(&what, &check, cause);
+        let which = match (&rest, usable.len()) {
+            (Some(_), 1) => "one of the two logs",
+            _ => "this log",
+        };
+        check.sentence = disagreement(&what, &check, cause, which);
     }
     Consistency::Checked(Box::new(check))
 }
@@ -159,10 +166,11 @@ pub fn as_exchangeable_phase(phase: &Calibration, joint: &Calibration) -> Calibr
     alike
 }
 
-/// "LOG and the joint estimate disagree …": the parameters that moved and the causes
-/// that fit a whole log (not the two-halves check's causes within one log), or
-/// `cause` when given.
-fn disagreement(what: &str, h: &HalvesCheck, cause: Option<&str>) -> String {
+/// "LOG and … disagree …": the parameters that moved and the causes that fit a whole
+/// log (not the two-halves check's causes within one log), said of `which` log ("this
+/// log", or "one of the two logs" when the log is compared with one other), or `cause`
+/// when given.
+fn disagreement(what: &str, h: &HalvesCheck, cause: Option<&str>, which: &str) -> String {
     let mut moved: Vec<usize> = (0..6).filter(|&i| h.z[i].abs() > Z_LIMIT).collect();
     if moved.is_empty() {
         moved = (0..6).collect();
@@ -174,16 +182,16 @@ fn disagreement(what: &str, h: &HalvesCheck, cause: Option<&str>) -> String {
         .map(|&i| format!("{} by {:.1}σ", PARAMETER_NAMES[i], h.z[i].abs()))
         .collect();
     let cause = match cause {
-        Some(cause) => cause,
-        None if moved.iter().all(|&i| i >= 3) => {
-            "likely the laser was mounted elsewhere for this log, or this log has a fault of \
-             its own (see its findings)"
-        }
-        None => {
-            "likely this log was recorded on another robot, another floor or with other tyres \
-             or load, or the laser was mounted elsewhere, or this log has a fault of its own \
+        Some(cause) => cause.to_string(),
+        None if moved.iter().all(|&i| i >= 3) => format!(
+            "likely the laser was mounted elsewhere for {which}, or {which} has a fault of its \
+             own (see its findings)"
+        ),
+        None => format!(
+            "likely {which} was recorded on another robot, another floor or with other tyres \
+             or load, or the laser was mounted elsewhere, or {which} has a fault of its own \
              (see its findings)"
-        }
+        ),
     };
     format!(
         "{what} disagree beyond 3σ ({}; χ² {:.1} for {} parameters, 3σ level {:.1}): {cause}",
@@ -206,27 +214,12 @@ fn combined(
     at: &Calibration,
     options: &SolveOptions,
 ) -> Option<(Calibration, [[f64; 6]; 6])> {
-    if others.is_empty() {
-        return None;
-    }
     let free: Vec<usize> = (0..6)
         .filter(|&i| !options.constraints.is_held(i))
         .collect();
-    let n = free.len();
-    let block = |c: &Calibration| DMatrix::from_fn(n, n, |p, q| c.covariance[free[p]][free[q]]);
-    let mut information = DMatrix::zeros(n, n);
-    let mut pulled = DVector::zeros(n);
-    for other in others {
-        let c_j = block(other).cholesky()?;
-        // Each one's difference from the log, so that headings combine unwrapped.
-        let d = other.params.difference(&log.params);
-        let d = DVector::from_fn(n, |p, _| d[free[p]]);
-        pulled += c_j.solve(&d);
-        information += c_j.inverse();
-    }
-    let information = (&information + information.transpose()) * 0.5;
-    let c_rest = information.cholesky()?.inverse();
-    let shift = &c_rest * pulled;
+    let estimates: Vec<(&Params, &[[f64; 6]; 6])> =
+        others.iter().map(|c| (&c.params, &c.covariance)).collect();
+    let (shift, c_rest) = combine_on(&log.params, &estimates, &free)?;
     let own = log.params.to_vector();
     let mut v = at.params.to_vector();
     for (p, &i) in free.iter().enumerate() {
@@ -247,6 +240,34 @@ fn combined(
         .flatten()
         .all(|v: &f64| v.is_finite())
         .then_some((rest, sum))
+}
+
+/// The estimates `others` (parameters and covariance) combined by their information
+/// over the parameters `free` (each one's marginal there): the combination minus
+/// `log` (headings unwrapped by taking each one's difference from `log`) and its
+/// covariance, `(Σ C_j⁻¹)⁻¹`. `None` when no other is given or a covariance is not
+/// positive definite over `free`.
+fn combine_on(
+    log: &Params,
+    others: &[(&Params, &[[f64; 6]; 6])],
+    free: &[usize],
+) -> Option<(DVector<f64>, DMatrix<f64>)> {
+    if others.is_empty() || free.is_empty() {
+        return None;
+    }
+    let n = free.len();
+    let mut information = DMatrix::zeros(n, n);
+    let mut pulled = DVector::zeros(n);
+    for (params, covariance) in others {
+        let c_j = DMatrix::from_fn(n, n, |p, q| covariance[free[p]][free[q]]).cholesky()?;
+        let d = params.difference(log);
+        pulled += c_j.solve(&DVector::from_fn(n, |p, _| d[free[p]]));
+        information += c_j.inverse();
+    }
+    let information = (&information + information.transpose()) * 0.5;
+    let c_rest = information.cholesky()?.inverse();
+    let shift = &c_rest * pulled;
+    (shift.iter().chain(c_rest.iter()).all(|v| v.is_finite())).then_some((shift, c_rest))
 }
 
 /// `C_log − C_joint` over the free parameters when it is positive definite (the
@@ -412,6 +433,56 @@ pub fn widen_to_spread(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use odocal_geom::Pose2;
+
+    fn params(b: f64, theta: f64) -> Params {
+        Params {
+            r_l: 0.03,
+            r_r: 0.03,
+            b,
+            laser: Pose2::new(0.1, 0.0, theta),
+        }
+    }
+
+    fn diagonal(v: [f64; 6]) -> [[f64; 6]; 6] {
+        std::array::from_fn(|i| std::array::from_fn(|j| if i == j { v[i] } else { 0.0 }))
+    }
+
+    #[test]
+    fn the_other_logs_combine_by_their_information() {
+        let log = params(0.300, 0.0);
+        let all: Vec<usize> = (0..6).collect();
+        // One other: its difference from the log and its own covariance.
+        let one = params(0.306, 0.0);
+        let c1 = diagonal([1e-8, 1e-8, 4e-6, 1e-4, 1e-4, 1e-4]);
+        let (shift, c) = combine_on(&log, &[(&one, &c1)], &all).expect("combined");
+        assert!((shift[2] - 0.006).abs() < 1e-12, "{shift}");
+        assert!((c[(2, 2)] - 4e-6).abs() < 1e-18);
+        // Two: b at 0.306 (σ² 4e-6) and 0.303 (σ² 1e-6): the weighted mean 0.3036, its
+        // variance 0.8e-6.
+        let two = params(0.303, 0.0);
+        let c2 = diagonal([1e-8, 1e-8, 1e-6, 1e-4, 1e-4, 1e-4]);
+        let (shift, c) = combine_on(&log, &[(&one, &c1), (&two, &c2)], &all).expect("combined");
+        assert!((shift[2] - 0.0036).abs() < 1e-12, "{shift}");
+        assert!((c[(2, 2)] - 0.8e-6).abs() < 1e-15);
+        // Headings either side of ±π combine unwrapped.
+        let log = params(0.300, std::f64::consts::PI - 0.01);
+        let across = params(0.300, -std::f64::consts::PI + 0.01);
+        let (shift, _) = combine_on(&log, &[(&across, &c1)], &all).expect("combined");
+        assert!((shift[5] - 0.02).abs() < 1e-12, "{shift}");
+        // Over the free parameters only: b held, its zero variance not inverted.
+        let mut held = c1;
+        held[2][2] = 0.0;
+        assert!(combine_on(&log, &[(&one, &held)], &all).is_none());
+        let free = [0, 1, 3, 4, 5];
+        let (shift, c) = combine_on(&log, &[(&one, &held)], &free).expect("combined");
+        assert_eq!((shift.len(), c.nrows()), (5, 5));
+        // Nothing to combine, or a covariance that is not finite.
+        assert!(combine_on(&log, &[], &all).is_none());
+        let mut bad = c1;
+        bad[3][3] = f64::NAN;
+        assert!(combine_on(&log, &[(&one, &bad)], &all).is_none());
+    }
 
     #[test]
     fn a_difference_nearly_singular_in_one_direction_is_not_kept() {
