@@ -136,6 +136,11 @@ fn shift_words(slip: &LateralSlip, i: usize, n: f64) -> String {
     )
 }
 
+/// The least weight of the model with the slide for its noise to be measured on its
+/// own residuals ([`odocal_solver::SlideFit::measure_noise_with_slide`]); a clean
+/// Khepera's slide weighs 0.03 %.
+const MEASURED_WEIGHT: f64 = 0.01;
+
 /// Checks `calibration` (computed from `samples` with `options`) for the slide and,
 /// as `model` says, weighs the estimate with the slide into it ([`slide_weight`]).
 /// The slide is recorded in `calibration.lateral_slip` whenever it was checked.
@@ -148,13 +153,19 @@ pub fn check_and_apply(
     if model == SlideModel::Off {
         return;
     }
-    let Some(fit) = fit_lateral_slip(samples, calibration, options) else {
+    let Some(mut fit) = fit_lateral_slip(samples, calibration, options) else {
         return;
     };
     let weight = match model {
         SlideModel::Estimate => 1.0,
         _ => slide_weight(&fit.slip),
     };
+    // The model with the slide, where it weighs in, takes its noise from the
+    // residuals it leaves (a solve more; below MEASURED_WEIGHT its share of the σ is
+    // too small to matter).
+    if weight >= MEASURED_WEIGHT {
+        fit.measure_noise_with_slide(samples, options);
+    }
     fit.blend(calibration, weight);
 }
 
