@@ -4,9 +4,13 @@
 //!
 //! [`fit_lateral_slip`] refines the six parameters and `k` together by maximum
 //! likelihood on the samples a [`Calibration`] used, with its noise model, from its
-//! estimate and `k = 0`; [`SlideFit::apply`] puts the result into the calibration:
-//! the parameters at the joint optimum and their covariance widened by what not
-//! knowing `k` adds. The six-parameter solve itself is untouched.
+//! estimate and `k = 0`; [`SlideFit::measure_noise_with_slide`] measures the
+//! covariance with `k` known on the residuals the model with the slide leaves; and
+//! [`SlideFit::apply`] puts the result into the calibration: the parameters at the
+//! joint optimum and their covariance widened by what not knowing `k` adds. The
+//! six-parameter solve itself is untouched. (`k`'s own σ and its covariance with the
+//! six still come from the six-parameter solve's noise model: what not knowing `k`
+//! adds is 6 % of ℓθ's variance on the simulated rover.)
 
 use crate::calibrate::{calibrate, Calibration, SolveOptions};
 use crate::constraints::Constraints;
