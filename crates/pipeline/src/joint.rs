@@ -372,13 +372,12 @@ fn calibrate_joint(
             let constraints = lasers.constraints_of(k, &solve_options.constraints);
             let compared = comparison_options(&solve_options, constraints, &view, alone);
             // One laser: the other logs' own estimates are the comparison's other side.
-            let others: Vec<(&str, &Calibration)> = if solved.lasers.is_none() {
-                logs.iter()
-                    .zip(&outcomes)
-                    .enumerate()
-                    .filter(|&(j, _)| j != index)
-                    .map(|(_, ((other, _), o))| (*other, &o.calibration))
-                    .collect()
+            let others = if solved.lasers.is_none() {
+                all_but(
+                    index,
+                    logs.iter().map(|(n, _)| *n),
+                    outcomes.iter().map(|o| &o.calibration),
+                )
             } else {
                 Vec::new()
             };
@@ -401,32 +400,32 @@ fn calibrate_joint(
         .iter()
         .map(|g| format!("{} (its {} phases together)", g.name, g.logs.len()))
         .collect();
-    let phase_groups: Vec<PhaseGroupCheck> = groups
-        .iter()
-        .zip(&group_calibrations)
-        .enumerate()
-        .map(|(index, (g, calibration))| {
-            let others: Vec<(&str, &Calibration)> = group_names
-                .iter()
-                .zip(&group_calibrations)
-                .enumerate()
-                .filter(|&(j, _)| j != index)
-                .map(|(_, (other, c))| (other.as_str(), c))
-                .collect();
-            let agreement = check_log(
-                calibration,
-                &others,
+    // (None for one log given in phases: its phases are compared one by one.)
+    let group_agreements: Vec<Consistency> = (0..group_calibrations.len())
+        .map(|index| {
+            check_log(
+                &group_calibrations[index],
+                &all_but(
+                    index,
+                    group_names.iter().map(String::as_str),
+                    &group_calibrations,
+                ),
                 &solved.first,
                 &solve_options,
                 &group_names[index],
                 false,
-            );
-            PhaseGroupCheck {
-                name: g.name.clone(),
-                logs: g.logs.clone(),
-                calibration: calibration.clone(),
-                agreement,
-            }
+            )
+        })
+        .collect();
+    let phase_groups: Vec<PhaseGroupCheck> = groups
+        .iter()
+        .zip(group_calibrations)
+        .zip(group_agreements)
+        .map(|((g, calibration), agreement)| PhaseGroupCheck {
+            name: g.name.clone(),
+            logs: g.logs.clone(),
+            calibration,
+            agreement,
         })
         .collect();
     let Solved {
@@ -703,6 +702,21 @@ fn group_estimate(
         refuse_poorly_determined(calibration, &t.synced, &t.samples, &t.solve_options, &own)
             .map_err(failed)?;
     Ok((calibration, shared))
+}
+
+/// Every log's name and estimate (`names`, `calibrations`, in the same order) but
+/// the one at `index`: the other side of its comparison.
+fn all_but<'a>(
+    index: usize,
+    names: impl Iterator<Item = &'a str>,
+    calibrations: impl IntoIterator<Item = &'a Calibration>,
+) -> Vec<(&'a str, &'a Calibration)> {
+    names
+        .zip(calibrations)
+        .enumerate()
+        .filter(|&(j, _)| j != index)
+        .map(|(_, pair)| pair)
+        .collect()
 }
 
 /// The residuals of `samples` at `calibration`'s estimate, its sideways slide as

@@ -94,10 +94,11 @@ fn check_with_cause(
     let rest = (!own_covariance)
         .then(|| combined(log, &estimates, joint, &compared))
         .flatten();
-    let other_side = match (&rest, usable.as_slice()) {
-        (Some(_), [(other, _)]) => other.to_string(),
-        (Some(_), _) => "the other logs together".to_string(),
-        (None, _) => "the joint estimate".to_string(),
+    // The other side, and whom a disagreement's causes are said of.
+    let (other_side, which) = match (&rest, usable.as_slice()) {
+        (Some(_), [(other, _)]) => (other.to_string(), "one of the two logs"),
+        (Some(_), _) => ("the other logs together".to_string(), "this log"),
+        (None, _) => ("the joint estimate".to_string(), "this log"),
     };
     let what = if weak.is_empty() {
         format!("{name} and {other_side}")
@@ -120,10 +121,6 @@ fn check_with_cause(
         }
     };
     if !check.agree {
-        let which = match (&rest, usable.len()) {
-            (Some(_), 1) => "one of the two logs",
-            _ => "this log",
-        };
         check.sentence = disagreement(&what, &check, cause, which);
     }
     Consistency::Checked(Box::new(check))
